@@ -1,0 +1,53 @@
+# apair: `make` sets up .venv, regenerates every derivation and kernel, builds the C library and runs
+# the demonstration; `make test` runs the whole suite (including `make check`).
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+PY := $(BIN)/python
+DEPS_STAMP := $(VENV)/.deps-stamp
+CFLAGS_STRICT := -std=c99 -Wall -Wextra -Werror -pedantic -O2
+CHECK_DIR := build/check-generated
+
+.PHONY: all venv generate install lib demo check test clean
+
+all: generate install lib demo
+
+$(PY):
+	$(PYTHON) -m venv $(VENV)
+
+# Dependencies (and a first install of the package) whenever pyproject.toml changes.
+$(DEPS_STAMP): pyproject.toml setup.py | $(PY)
+	$(PY) -m pip install --quiet --upgrade pip "setuptools>=77" wheel
+	$(PY) -m pip install --quiet ".[dev]"
+	touch $@
+
+venv: $(DEPS_STAMP)
+
+generate: $(DEPS_STAMP)
+	PYTHONPATH=. $(PY) -m codegen
+
+# Non-editable install of the runtime with the current generated/ (builds the C kernels too).
+install: $(DEPS_STAMP)
+	$(PY) -m pip install --quiet --no-deps --no-build-isolation --force-reinstall .
+
+# The C kernels as a plain shared library, built with the strict flags users may have.
+lib: build/libapair.so
+build/libapair.so: $(wildcard generated/c/*.c generated/c/*.h)
+	mkdir -p build
+	gcc $(CFLAGS_STRICT) -fPIC -shared generated/c/*.c -o $@ -lm
+
+demo: install
+	$(BIN)/apair demo examples/4a_chain.toml
+
+# Regenerate into a scratch folder and fail if it differs from the committed generated/.
+check: $(DEPS_STAMP)
+	rm -rf $(CHECK_DIR)
+	PYTHONPATH=. $(PY) -m codegen --out $(CHECK_DIR)
+	diff -r -x __pycache__ generated $(CHECK_DIR) || \
+	  (echo "generated/ is out of date with the derivations: run make generate and commit" >&2; exit 1)
+
+test: check install lib
+	$(PY) -m pytest -q
+
+clean:
+	rm -rf build .venv *.egg-info src/*.egg-info

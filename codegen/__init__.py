@@ -1,0 +1,1 @@
+"""Code generation: kernel specs -> CSE -> jinja2 templates -> generated/ (one emitter)."""

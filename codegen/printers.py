@@ -1,0 +1,52 @@
+"""Expression printers for the two targets: C99 (libm) and NumPy."""
+from __future__ import annotations
+
+import sympy as sp
+from sympy.printing.c import C99CodePrinter
+from sympy.printing.numpy import NumPyPrinter
+
+
+def _small_power(printer, expr) -> str | None:
+    """x**k for |k| ≤ 4 and half-integers as products and sqrt: exact, and faster than pow()."""
+    base, exp = expr.as_base_exp()
+    if not exp.is_Rational:
+        return None
+    b = printer.parenthesize(base, sp.printing.precedence.PRECEDENCE["Mul"] + 1)
+    num, den = int(exp.p), int(exp.q)
+    if den == 1 and 2 <= abs(num) <= 4:
+        prod = "*".join([b] * abs(num))
+        return f"({prod})" if num > 0 else f"(1.0/({prod}))"
+    if den == 2 and abs(num) <= 5 and num != 1 and num != -1:
+        k = (abs(num) - 1) // 2
+        root = f"{printer._sqrt_name}({printer._print(base)})"
+        prod = "*".join([root] + [b] * k)
+        return f"({prod})" if num > 0 else f"(1.0/({prod}))"
+    return None
+
+
+class CPrinter(C99CodePrinter):
+    """C99 without M_PI and friends (not in strict C99): constants print as decimal literals."""
+
+    _sqrt_name = "sqrt"
+
+    def __init__(self):
+        super().__init__({"math_macros": {}})
+
+    def _print_NumberSymbol(self, expr):
+        return sp.Float(expr.evalf(25), 25).__str__()
+
+    _print_Pi = _print_NumberSymbol
+    _print_Exp1 = _print_NumberSymbol
+
+    def _print_Pow(self, expr):
+        return _small_power(self, expr) or super()._print_Pow(expr)
+
+
+class NumpyPrinter(NumPyPrinter):
+    _sqrt_name = "numpy.sqrt"
+
+    def __init__(self):
+        super().__init__({"fully_qualified_modules": True, "inline": True})
+
+    def _print_Pow(self, expr, rational=False):
+        return _small_power(self, expr) or super()._print_Pow(expr, rational=rational)

@@ -1,0 +1,13 @@
+"""apair: closed-form kinematics of algebraic screw pairs (A-pairs) and A-chains.
+
+The closed forms are derived symbolically (derivations/), emitted as C and NumPy kernels
+(codegen/ -> generated/), and loaded here. See CONVENTIONS.md for frames and conventions.
+"""
+from . import polynomials
+from .chain import AChain
+from .io import load
+from .kernels import backend, c_available, set_backend
+from .pair import APair
+
+__version__ = "0.1.0"
+__all__ = ["APair", "AChain", "load", "polynomials", "set_backend", "backend", "c_available", "__version__"]

@@ -1,0 +1,46 @@
+"""Input checks shared by the runtime: every failure is a ValueError that names the argument."""
+from __future__ import annotations
+
+import numpy as np
+
+
+def real_array(name: str, value, *, trailing: tuple[int, ...] | None = None, ndim_max: int | None = None) -> np.ndarray:
+    """A finite float64 array; `trailing` fixes the last axes' shape."""
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name}: expected real numbers, got {value!r}") from exc
+    if raw.dtype.kind not in "iuf":  # no booleans, complex numbers, strings or objects
+        raise ValueError(f"{name}: expected real numbers, got {raw.dtype.name} values {value!r}")
+    arr = raw.astype(np.float64, copy=False)
+    if trailing is not None:
+        k = len(trailing)
+        if arr.ndim < k or arr.shape[arr.ndim - k:] != trailing:
+            want = "(" + ", ".join(["..."] + [str(t) for t in trailing]) + ")"
+            raise ValueError(f"{name}: expected shape {want}, got {arr.shape}")
+    if ndim_max is not None and arr.ndim > ndim_max:
+        raise ValueError(f"{name}: expected at most {ndim_max} dimensions, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name}: contains NaN or infinite values")
+    return arr
+
+
+def scalar(name: str, value, *, positive: bool = False, nonnegative: bool = False) -> float:
+    """A finite real scalar, optionally > 0 or ≥ 0."""
+    arr = real_array(name, value)
+    if arr.ndim != 0:
+        raise ValueError(f"{name}: expected a scalar, got shape {arr.shape}")
+    x = float(arr)
+    if positive and not x > 0:
+        raise ValueError(f"{name}: must be > 0, got {x}")
+    if nonnegative and not x >= 0:
+        raise ValueError(f"{name}: must be >= 0, got {x}")
+    return x
+
+
+def vector(name: str, value, n: int) -> np.ndarray:
+    """A finite vector of exactly n entries (a scalar is not accepted)."""
+    arr = real_array(name, value)
+    if arr.shape != (n,):
+        raise ValueError(f"{name}: expected shape ({n},), got {arr.shape}")
+    return arr

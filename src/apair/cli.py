@@ -1,0 +1,120 @@
+"""The `apair` command line: inspect derived polynomials, evaluate chains, run the demonstration."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+import numpy as np
+
+from . import __version__, polynomials
+from .io import load
+from .kernels import backend, manifest
+
+
+def _cmd_list(args) -> int:
+    for name in polynomials.names():
+        data = polynomials.raw(name)
+        print(f"{name:16s} {len(data['entries']):3d} entries  {data['title']}")
+    return 0
+
+
+def _cmd_show(args) -> int:
+    if args.json:
+        print(json.dumps(polynomials.raw(args.name), indent=1))
+    else:
+        print(polynomials.text(args.name, "tex" if args.latex else "txt"), end="")
+    return 0
+
+
+def _parse_angles(values, deg: bool) -> np.ndarray:
+    q = []
+    for v in values:
+        try:
+            q.append(float(v))
+        except ValueError:
+            raise ValueError(f"Q: {v!r} is not a number") from None
+    q = np.array(q)
+    return np.radians(q) if deg else q
+
+
+def _cmd_fk(args) -> int:
+    chain = load(args.file)
+    q = _parse_angles(args.q, args.deg)
+    if q.shape != (chain.n,):
+        raise ValueError(f"Q: {chain.name} has {chain.n} joints, got {q.size} angles")
+    T = chain.fk(q)
+    S = chain.fk_study(q)
+    with np.printoptions(precision=12, suppress=True, floatmode="maxprec"):
+        print(f"{chain.name}: {chain.n} joints, q = {q} rad (backend: {backend()})")
+        print("T =")
+        print(T)
+        print("Study point (x0 x1 x2 x3 y0 y1 y2 y3) =")
+        print(S)
+    return 0
+
+
+def _cmd_demo(args) -> int:
+    motion = polynomials.load("apair_motion")
+    print("The A-pair, derived from the six leg constraints of a Griffis-Duffy platform:")
+    for label in ("consistency", "a", "b", "pair_quadric", "law", "sinusoidal_L1", "sinusoidal_amplitude",
+                  "law_sinusoidal"):
+        e = motion[label]
+        print(f"  {label:22s} {e.lhs} = {e.rhs}" if hasattr(e, "rhs") else f"  {label:22s} {e} = 0")
+    if args.file:
+        chain = load(args.file)
+        q = np.linspace(0.3, -0.4, chain.n)
+        T = chain.fk(q)
+        with np.printoptions(precision=6, suppress=True):
+            print(f"\n{chain.name} ({args.file}), q = {q} rad, backend {backend()}:")
+            print(T)
+            print("Jacobian:")
+            print(chain.jacobian(q))
+    return 0
+
+
+def _cmd_kernels(args) -> int:
+    for name, k in sorted(manifest()["kernels"].items()):
+        ins = ", ".join(f"{a['name']}{tuple(a['shape'])}" for a in k["inputs"])
+        outs = ", ".join(f"{a['name']}{tuple(a['shape'])}" for a in k["outputs"])
+        print(f"{name:18s} {k['ops']:5d} ops  ({ins}) -> {outs}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="apair", description="Kinematics of A-pairs and A-chains.")
+    ap.add_argument("--version", action="version", version=f"apair {__version__}")
+    sub = ap.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("list", help="list the derived polynomial sets")
+    p.set_defaults(func=_cmd_list)
+    p = sub.add_parser("show", help="print a derived polynomial set")
+    p.add_argument("name", help="a set from `apair list`, e.g. apair_motion")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--latex", action="store_true", help="LaTeX instead of text")
+    g.add_argument("--json", action="store_true", help="the machine-readable form")
+    p.set_defaults(func=_cmd_show)
+    p = sub.add_parser("fk", help="forward kinematics of a chain file at joint angles Q")
+    p.add_argument("file", help="a chain TOML file (see README)")
+    p.add_argument("q", nargs="+", metavar="Q", help="joint angles (radians unless --deg)")
+    p.add_argument("--deg", action="store_true", help="angles in degrees")
+    p.set_defaults(func=_cmd_fk)
+    p = sub.add_parser("kernels", help="list the generated kernels with their operation counts")
+    p.set_defaults(func=_cmd_kernels)
+    p = sub.add_parser("demo", help="print the derived A-pair law and, given a chain file, one pose")
+    p.add_argument("file", nargs="?", help="a chain TOML file")
+    p.set_defaults(func=_cmd_demo)
+    return ap
+
+
+def main(argv=None) -> int:
+    ap = build_parser()
+    args = ap.parse_args(argv)
+    try:
+        return args.func(args)
+    except ValueError as exc:
+        print(f"apair {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

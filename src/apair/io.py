@@ -1,0 +1,108 @@
+"""Chains from TOML files (the format is documented in README.md, "Chain files").
+
+    name = "a 2A-chain"            # optional
+    [[joint]]                      # one table per joint, base to tip
+    pair = "sinusoidal"            # "sinusoidal" | "general" | "revolute"
+    base_radius = 0.05             # A-pairs: triangle circumradii [m]
+    platform_radius = 0.05
+    leg_length = 0.08              # "general" only: L1 [m]
+    leg_mass = 0.0                 # optional [kg]; leg_radius = 0.0 optional [m]
+    a = 0.3                        # DH link length [m]
+    alpha = 1.5707963267948966     # DH twist [rad], or alpha_deg = 90
+    offset = 0.0                   # c_i [m] (optional)
+    theta_offset = 0.0             # phi_i [rad] (optional), or theta_offset_deg
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+from .chain import AChain
+from .pair import KINDS, APair
+
+_PAIR_KEYS = {
+    "sinusoidal": {"base_radius", "platform_radius", "leg_mass", "leg_radius"},
+    "general": {"base_radius", "platform_radius", "leg_length", "leg_mass", "leg_radius"},
+    "revolute": set(),
+}
+_DH_KEYS = {"a", "alpha", "alpha_deg", "offset", "theta_offset", "theta_offset_deg"}
+
+
+def _angle(where: str, j: dict, key: str, default=None):
+    if key in j and f"{key}_deg" in j:
+        raise ValueError(f"{where}: give {key} or {key}_deg, not both")
+    if f"{key}_deg" in j:
+        v = j[f"{key}_deg"]
+        _number(f"{where}.{key}_deg", v)
+        return math.radians(v)
+    if key in j:
+        return _number(f"{where}.{key}", j[key])
+    if default is None:
+        raise ValueError(f"{where}: missing {key} (or {key}_deg)")
+    return default
+
+
+def _number(where: str, v):
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise ValueError(f"{where}: expected a number, got {v!r}")
+    return float(v)
+
+
+def chain_from_dict(data: dict, where: str = "chain") -> AChain:
+    """Build an AChain from the parsed TOML document."""
+    unknown = set(data) - {"name", "joint", "description"}
+    if unknown:
+        raise ValueError(f"{where}: unknown keys {sorted(unknown)}")
+    joints = data.get("joint")
+    if not isinstance(joints, list) or not joints:
+        raise ValueError(f"{where}: needs at least one [[joint]] table")
+    pairs, a, alpha, offset, theta_offset = [], [], [], [], []
+    for i, j in enumerate(joints):
+        w = f"{where}: joint[{i}]"
+        if not isinstance(j, dict):
+            raise ValueError(f"{w}: expected a [[joint]] table, got {j!r}")
+        kind = j.get("pair")
+        if kind not in KINDS:
+            raise ValueError(f"{w}.pair: expected one of {KINDS}, got {kind!r}")
+        allowed = _PAIR_KEYS[kind] | _DH_KEYS | {"pair"}
+        unknown = set(j) - allowed
+        if unknown:
+            raise ValueError(f"{w}: keys {sorted(unknown)} are not valid for a {kind} pair")
+        if kind == "revolute":
+            pairs.append(APair.revolute())
+        else:
+            kw = {k: _number(f"{w}.{k}", j[k]) for k in _PAIR_KEYS[kind] if k in j}
+            for req in ("base_radius", "platform_radius") + (("leg_length",) if kind == "general" else ()):
+                if req not in kw:
+                    raise ValueError(f"{w}: missing {req}")
+            try:
+                pairs.append(APair(**kw))
+            except ValueError as exc:
+                raise ValueError(f"{w}.{exc}") from None
+        if "a" not in j:
+            raise ValueError(f"{w}: missing a")
+        a.append(_number(f"{w}.a", j["a"]))
+        alpha.append(_angle(w, j, "alpha"))
+        offset.append(_number(f"{w}.offset", j.get("offset", 0.0)))
+        theta_offset.append(_angle(w, j, "theta_offset", 0.0))
+    try:
+        return AChain(pairs, a, alpha, offset, theta_offset)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
+
+
+def load(path) -> AChain:
+    """Read a chain from a TOML file."""
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"path: no such file {str(p)!r}")
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"path: {p} is not UTF-8 text: {exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"path: {p} is not valid TOML: {exc}") from None
+    chain = chain_from_dict(data, where=str(p))
+    chain.name = data.get("name", p.stem)
+    return chain

@@ -1,0 +1,119 @@
+"""`APair`: one algebraic screw pair (the self-motion of a Griffis-Duffy platform), or an R-pair.
+
+The pair's constants (L2, a, b, h) and its law d(θ), d'(θ), d''(θ) come from the generated kernels
+of derivations/apair_pair.py; this module only validates and dispatches.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import _validate as V
+from .kernels import call
+
+KINDS = ("sinusoidal", "general", "revolute")
+_SINUSOIDAL_RTOL = 1e-12  # |a - b| <= this * b: the leg length is the sinusoidal one
+
+
+class APair:
+    """An A-pair with base/platform circumradii r_b, r_p and leg length L1 (None: sinusoidal).
+
+    leg_mass and leg_radius describe the legs (uniform rods; used by dynamics and collisions).
+    """
+
+    def __init__(self, base_radius, platform_radius, leg_length=None, leg_mass=0.0, leg_radius=0.0):
+        r_b = V.scalar("base_radius", base_radius, positive=True)
+        r_p = V.scalar("platform_radius", platform_radius, positive=True)
+        self.leg_mass = V.scalar("leg_mass", leg_mass, nonnegative=True)
+        self.leg_radius = V.scalar("leg_radius", leg_radius, nonnegative=True)
+        self.base_radius, self.platform_radius = r_b, r_p
+        radii = np.array([r_b, r_p])
+        if leg_length is None:
+            L1, L2, a, b, h = call("design_sinusoidal", radii)[0]
+            self.kind = "sinusoidal"
+        else:
+            L1 = V.scalar("leg_length", leg_length, positive=True)
+            L2_sq, a, b, a_plus_b = call("design_general", radii, [L1])[0]
+            if not a_plus_b > 0 or not L2_sq > 0:
+                lo = math.sqrt(r_b**2 + r_p**2 / 4 - r_b * r_p) if r_b**2 + r_p**2 / 4 > r_b * r_p else 0.0
+                raise ValueError(
+                    f"leg_length: L1 = {L1} admits no real pose of this pair (need a + b > 0, i.e. "
+                    f"L1 > {lo:.6g} for base_radius={r_b}, platform_radius={r_p})")
+            L2 = math.sqrt(L2_sq)
+            self.kind = "sinusoidal" if abs(a - b) <= _SINUSOIDAL_RTOL * b else "general"
+            h = math.sqrt(2 * b) if self.kind == "sinusoidal" else None
+        self._L = (float(L1), float(L2))
+        self.a, self.b = float(a), float(b)
+        self._h = float(h) if h is not None else None
+
+    @classmethod
+    def revolute(cls) -> "APair":
+        """An R-pair: no translation (d ≡ 0) and no legs."""
+        self = cls.__new__(cls)
+        self.kind = "revolute"
+        self.base_radius = self.platform_radius = 0.0
+        self.leg_mass = self.leg_radius = 0.0
+        self._L = None
+        self.a = self.b = 0.0
+        self._h = 0.0
+        return self
+
+    def __repr__(self) -> str:
+        if self.kind == "revolute":
+            return "APair.revolute()"
+        ll = "" if self.kind == "sinusoidal" else f", leg_length={self._L[0]!r}"
+        return f"APair({self.base_radius!r}, {self.platform_radius!r}{ll})"
+
+    @property
+    def amplitude(self) -> float:
+        """The platform's rise d(0) − min d over the motion: h = √(2 r_b r_p) for a sinusoidal pair."""
+        if self._h is not None:
+            return self._h
+        return math.sqrt(self.a + self.b) - math.sqrt(max(self.a - self.b, 0.0))
+
+    @property
+    def leg_lengths(self) -> np.ndarray:
+        """(6,): three legs of length L1 (base vertices), three of length L2; empty for an R-pair."""
+        if self._L is None:
+            return np.zeros(0)
+        return np.repeat(np.array(self._L), 3)
+
+    @property
+    def theta_limit(self) -> float | None:
+        """|θ| ≤ arccos(−a/b) for a general pair with a < b; None where θ is unbounded."""
+        if self.kind == "general" and self.a < self.b:
+            return math.acos(-self.a / self.b)
+        return None
+
+    def _theta(self, theta, name="theta") -> np.ndarray:
+        th = V.real_array(name, theta)
+        if self.kind == "general" and self.a < self.b:
+            bad = self.a + self.b * np.cos(th) < 0
+            if np.any(bad):
+                raise ValueError(
+                    f"{name}: outside this pair's range |theta| <= {self.theta_limit:.12g} (mod 2 pi), "
+                    f"e.g. {th[bad].flat[0]!r}")
+        return th
+
+    def law(self, theta, name="theta") -> np.ndarray:
+        """(..., 3): d(θ), d'(θ), d''(θ); broadcasts over θ."""
+        th = self._theta(theta, name)
+        if self.kind == "revolute":
+            return np.zeros(th.shape + (3,))
+        if self.kind == "sinusoidal":
+            return call("law_sinusoidal", th[..., None], [self._h])[0]
+        return call("law_general", th[..., None], [self.a], [self.b])[0]
+
+    def translation(self, theta) -> np.ndarray:
+        """d(θ) [m], broadcasting over θ (a float for a scalar θ)."""
+        d = self.law(theta)[..., 0]
+        return float(d) if d.ndim == 0 else d
+
+    def leg_endpoints(self, theta) -> np.ndarray:
+        """(..., 6, 2, 3): [base point, platform point] of each leg in the pair's base frame."""
+        th = self._theta(theta)
+        if self.kind == "revolute":
+            return np.zeros(th.shape + (0, 2, 3))
+        d = self.law(th)[..., 0]
+        return call("pair_legs", th[..., None], d[..., None], [self.base_radius, self.platform_radius])[0]
