@@ -211,10 +211,43 @@ def joint_polynomials() -> PolynomialSet:
     )
 
 
+def chain_study_polynomials(n: int = 2) -> PolynomialSet:
+    """The Study point of an n-joint chain, expanded in the half-angle variables of its joints.
+
+    With C_i, S_i = cos, sin((θ_i + φ_i)/2), K_i, L_i = cos, sin(α_i/2) and D_i = c_i + d_i(θ_i),
+    each component is a polynomial; its degrees and term counts are what constraint varieties and
+    inverse kinematics work with.
+    """
+    _, J = chain_inputs(n)
+    subs, gens = {}, []
+    P = None
+    for i, j in enumerate(J, start=1):
+        C, S, K, L, D = sp.symbols(f"C_{i} S_{i} K_{i} L_{i} D_{i}", real=True)
+        gens += [C, S, K, L, j["a"], D]
+        half_t, half_a = (j["theta"] + j["phi"]) / 2, j["alpha"] / 2
+        subs.update({sp.cos(half_t): C, sp.sin(half_t): S, sp.cos(half_a): K, sp.sin(half_a): L})
+        Q = dh_study(j)
+        Q = StudyPoint(Quaternion(*[sp.expand(c).xreplace(subs).subs(j["c"] + j["d"], D) for c in Q.x.as_list()]),
+                       Quaternion(*[sp.expand(sp.expand(c).xreplace(subs).subs(j["c"], D - j["d"])) for c in Q.y.as_list()]))
+        P = Q if P is None else P * Q
+    names = ["x0", "x1", "x2", "x3", "y0", "y1", "y2", "y3"]
+    comps = [sp.expand(c) for c in P.as_list()]
+    for c in comps:
+        assert c.free_symbols <= set(gens), c.free_symbols - set(gens)
+    return PolynomialSet(
+        name=f"chain{n}_study",
+        title=f"Study point of a {n}-joint A-chain in half-angle variables",
+        source=SOURCE,
+        description=("C_i, S_i = cos, sin((theta_i + phi_i)/2); K_i, L_i = cos, sin(alpha_i/2); "
+                     "D_i = c_i + d_i(theta_i) (d_i = h_i cos(theta_i/2) for a sinusoidal pair)."),
+        entries=[Entry(nm, c, tuple(gens)) for nm, c in zip(names, comps)],
+    )
+
+
 def derive():
     """All chain-kinematics kernels for n = 1..MAX_N, after checking the Jacobian route."""
     checks = {n: check_jacobian(n) for n in (1, 2, 3)}
     specs = []
     for n in range(1, MAX_N + 1):
         specs += [fk_spec(n), fk_study_spec(n), jacobian_spec(n)]
-    return [joint_polynomials()], specs, {"jacobian_check": checks}
+    return [joint_polynomials(), chain_study_polynomials(2)], specs, {"jacobian_check": checks}

@@ -92,3 +92,24 @@ def test_every_generated_file_names_its_source_and_hash():
             head = p.read_text()[:600]
             assert "Do not edit" in head and ("Content hash" in head), p
             assert "derivations/" in head or p.name == "__init__.py", p
+
+
+def test_chain2_study_polynomials_are_the_kernel(backend):
+    """The printed Study point of a 2-joint chain evaluates to fk_study of a random 2A-chain."""
+    import numpy as np
+
+    eqs = apair.polynomials.load("chain2_study")
+    rng = np.random.default_rng(8)
+    chain = apair.AChain([apair.APair(0.3, 0.5), apair.APair(0.4, 0.2, leg_length=0.45)],
+                         rng.uniform(-1, 1, 2), rng.uniform(-3, 3, 2), rng.uniform(-1, 1, 2), rng.uniform(-3, 3, 2))
+    q = rng.uniform(-1, 1, 2)
+    d = [p.translation(x) for p, x in zip(chain.pairs, q)]
+    values = {}
+    for i in range(2):
+        ht, ha = (q[i] + chain.theta_offset[i]) / 2, chain.alpha[i] / 2
+        for name, v in [("C", np.cos(ht)), ("S", np.sin(ht)), ("K", np.cos(ha)), ("L", np.sin(ha)),
+                        ("a", chain.a[i]), ("D", chain.offset[i] + d[i])]:
+            values[sp.Symbol(f"{name}_{i + 1}", real=True)] = v
+    got = np.array([float(eqs[n].xreplace(values)) for n in ("x0", "x1", "x2", "x3", "y0", "y1", "y2", "y3")])
+    want = chain.fk_study(q)
+    assert np.allclose(got, want, atol=1e-13) or np.allclose(got, -want, atol=1e-13)
