@@ -55,9 +55,9 @@ class AChain:
         q = self._q(q)
         return np.stack([p.law(q[..., i], name=f"q[..., {i}]") for i, p in enumerate(self.pairs)], axis=-2)
 
-    def _kernel(self, stem: str, q):
+    def _kernel(self, stem: str, q, law=None):
         q = self._q(q)
-        return call(f"{stem}{self.n}", q, self._dh, self.law(q))[0]
+        return call(f"{stem}{self.n}", q, self._dh, self.law(q) if law is None else law)[0]
 
     def fk(self, q) -> np.ndarray:
         """(..., 4, 4): the pose of frame n in the base frame; q is (n,) or (..., n)."""
@@ -69,7 +69,7 @@ class AChain:
 
     def jacobian(self, q) -> np.ndarray:
         """(..., 6, n): geometric Jacobian, base frame, rows [v; ω] (v of the origin of frame n)."""
-        law = self.law(self._q(q))
+        law = self.law(q)
         if np.any(~np.isfinite(law)):
             raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
-        return self._kernel("jacobian", q)
+        return self._kernel("jacobian", q, law)

@@ -98,7 +98,9 @@ class APair:
 
     def law(self, theta, name="theta") -> np.ndarray:
         """(..., 3): d(θ), d'(θ), d''(θ); broadcasts over θ."""
-        th = self._theta(theta, name)
+        return self._law(self._theta(theta, name))
+
+    def _law(self, th: np.ndarray) -> np.ndarray:
         if self.kind == "revolute":
             return np.zeros(th.shape + (3,))
         if self.kind == "sinusoidal":
@@ -115,5 +117,5 @@ class APair:
         th = self._theta(theta)
         if self.kind == "revolute":
             return np.zeros(th.shape + (0, 2, 3))
-        d = self.law(th)[..., 0]
+        d = self._law(th)[..., 0]
         return call("pair_legs", th[..., None], d[..., None], [self.base_radius, self.platform_radius])[0]
