@@ -41,7 +41,13 @@ class Lowered:
 
 
 def lower(spec: KernelSpec) -> Lowered:
-    """CSE over all outputs (steps substituted as a shared DAG), then collect the inputs used."""
+    """Straight-line code for a spec: its steps and outputs after CSE, in dependency order.
+
+    The steps are kept as named assignments (they are the derivation's own common subexpressions,
+    so a recursion stays linear in size); CSE runs over the step expressions and outputs with the
+    step symbols free, and the CSE temporaries are then placed just before their first use. Steps
+    that no output needs are dropped.
+    """
     arrays = {a.name for a in spec.inputs + spec.outputs}
     local = {}  # a scalar named like an array argument is renamed, e.g. theta -> theta_v
     for a in spec.inputs:
@@ -50,10 +56,21 @@ def lower(spec: KernelSpec) -> Lowered:
                 local[s] = sp.Symbol(f"{s}_v", real=True)
             if str(s).startswith("t") and str(s)[1:].isdigit():
                 raise ValueError(f"{spec.name}: input symbol {s} clashes with CSE temporaries")
-    exprs = [e.xreplace(local) for e in spec.expanded_outputs()]
+    outputs = [sp.S(e).xreplace(local) for a in spec.outputs for e in a.exprs]
+    needed = set().union(*(e.free_symbols for e in outputs)) if outputs else set()
+    steps = []
+    for sym, expr in reversed(spec.steps):
+        if sym in needed:
+            expr = expr.xreplace(local)
+            steps.append((sym, expr))
+            needed |= expr.free_symbols
+    steps.reverse()
+    exprs = [e for _, e in steps] + outputs
     replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), order="canonical")
+    assignments = _ordered(replacements, [(s, e) for (s, _), e in zip(steps, reduced[: len(steps)])])
+    reduced = reduced[len(steps):]
     used = set()
-    for _, e in replacements:
+    for _, e in assignments:
         used |= e.free_symbols
     for e in reduced:
         used |= sp.S(e).free_symbols
@@ -65,8 +82,32 @@ def lower(spec: KernelSpec) -> Lowered:
     for a in spec.outputs:
         outs.append((a, list(reduced[pos:pos + a.size])))
         pos += a.size
-    ops = int(sp.count_ops([e for _, e in replacements] + list(reduced)))
-    return Lowered(spec, inputs, [(str(s), e) for s, e in replacements], outs, ops)
+    ops = int(sp.count_ops([e for _, e in assignments] + list(reduced)))
+    return Lowered(spec, inputs, [(str(s), e) for s, e in assignments], outs, ops)
+
+
+def _ordered(replacements, steps):
+    """Steps in their order, each preceded by the CSE temporaries it needs (first use first)."""
+    temp = dict(replacements)
+    index = {s: k for k, (s, _) in enumerate(replacements)}
+    done, out = set(), []
+
+    def need(expr):
+        for s in sorted(expr.free_symbols & temp.keys() - done, key=index.__getitem__):
+            if s not in done:
+                need(temp[s])
+                done.add(s)
+                out.append((s, temp[s]))
+
+    for sym, expr in steps:
+        need(expr)
+        out.append((sym, expr))
+    for s, e in replacements:  # those only the outputs use
+        if s not in done:
+            need(e)
+            done.add(s)
+            out.append((s, e))
+    return out
 
 
 def _shape_doc(a: Arg) -> str:

@@ -51,6 +51,8 @@ class KernelSpec:
                 raise ValueError(f"{self.name}: output {a.name} has {len(a.exprs)} exprs for shape {a.shape}")
         known = {s for a in self.inputs for s in a.symbols}
         for sym, expr in self.steps:
+            if sym in known:
+                raise ValueError(f"{self.name}: step {sym} is defined twice (or shadows an input)")
             missing = expr.free_symbols - known
             if missing:
                 raise ValueError(f"{self.name}: step {sym} uses undefined {sorted(map(str, missing))}")

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: ca60a5ea4e272431
+Content hash: b2dc4f0a25274b9d
 """

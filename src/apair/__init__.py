@@ -7,7 +7,9 @@ from . import polynomials
 from .chain import AChain
 from .io import load
 from .kernels import backend, c_available, set_backend
+from .link import Link
 from .pair import APair
+from .simulate import Trajectory
 
 __version__ = "0.1.0"
-__all__ = ["APair", "AChain", "load", "polynomials", "set_backend", "backend", "c_available", "__version__"]
+__all__ = ["APair", "AChain", "Link", "Trajectory", "load", "polynomials", "set_backend", "backend", "c_available", "__version__"]

@@ -10,6 +10,7 @@ import numpy as np
 
 from . import _validate as V
 from .kernels import call
+from .link import Link
 from .pair import APair
 from .study import normalise
 
@@ -20,7 +21,7 @@ class AChain:
     """A chain of `pairs` with DH constants a (link lengths), alpha (twists), offset (c),
     theta_offset (φ). Angles in radians, lengths in metres."""
 
-    def __init__(self, pairs, a, alpha, offset=None, theta_offset=None):
+    def __init__(self, pairs, a, alpha, offset=None, theta_offset=None, links=None, gravity=(0.0, 0.0, -9.81)):
         try:
             pairs = list(pairs)
         except TypeError as exc:
@@ -37,6 +38,21 @@ class AChain:
         self.offset = np.zeros(n) if offset is None else V.vector("offset", offset, n)
         self.theta_offset = np.zeros(n) if theta_offset is None else V.vector("theta_offset", theta_offset, n)
         self._dh = np.ascontiguousarray(np.stack([self.a, self.alpha, self.offset, self.theta_offset], axis=1))
+        if links is None:
+            links = [Link(0.0) for _ in range(n)]
+        try:
+            links = list(links)
+        except TypeError as exc:
+            raise ValueError(f"links: expected a sequence of Link, got {links!r}") from exc
+        if len(links) != n:
+            raise ValueError(f"links: expected {n} links (one per pair), got {len(links)}")
+        for i, link in enumerate(links):
+            if not isinstance(link, Link):
+                raise ValueError(f"links[{i}]: expected a Link, got {type(link).__name__}")
+        self.links = links
+        self.gravity = V.vector("gravity", gravity, 3)
+        self._links = np.ascontiguousarray(np.stack([link.as_row() for link in links]))
+        self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pairs])
 
     @property
     def n(self) -> int:
@@ -44,7 +60,8 @@ class AChain:
 
     def __repr__(self) -> str:
         return (f"AChain({self.pairs!r}, a={self.a.tolist()}, alpha={self.alpha.tolist()}, "
-                f"offset={self.offset.tolist()}, theta_offset={self.theta_offset.tolist()})")
+                f"offset={self.offset.tolist()}, theta_offset={self.theta_offset.tolist()}, "
+                f"links={self.links!r}, gravity={self.gravity.tolist()})")
 
     def _q(self, q, name: str = "q") -> np.ndarray:
         q = V.real_array(name, q, trailing=(self.n,))
@@ -73,3 +90,74 @@ class AChain:
         if np.any(~np.isfinite(law)):
             raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
         return self._kernel("jacobian", q, law)
+
+    # ----------------------------------------------------------------------------- dynamics
+    def _state(self, q, qd=None, qdd=None):
+        """Validated (q, qd, qdd, law) broadcast to one batch shape."""
+        q = self._q(q)
+        arrays = [q] + [self._q(x, name) for x, name in ((qd, "qd"), (qdd, "qdd")) if x is not None]
+        try:
+            shape = np.broadcast_shapes(*(x.shape for x in arrays))
+        except ValueError:
+            raise ValueError(f"qd: batch shape does not match q: {[x.shape for x in arrays]}") from None
+        arrays = [np.broadcast_to(x, shape) for x in arrays]
+        law = self.law(arrays[0])
+        if np.any(~np.isfinite(law)):
+            raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
+        return arrays, law
+
+    def mass_matrix(self, q) -> np.ndarray:
+        """(..., n, n): M(θ), legs included."""
+        (q,), law = self._state(q)
+        return call(f"mass_matrix{self.n}", q, self._dh, law, self._links, self._legs)[0]
+
+    def coriolis_matrix(self, q, qd) -> np.ndarray:
+        """(..., n, n): C(θ, θ') in Christoffel form (Ṁ − 2C is skew-symmetric)."""
+        (q, qd), law = self._state(q, qd)
+        return call(f"coriolis{self.n}", q, qd, self._dh, law, self._links, self._legs)[0]
+
+    def gravity_torques(self, q) -> np.ndarray:
+        """(..., n): g(θ) = ∂V/∂θ."""
+        (q,), law = self._state(q)
+        return call(f"gravity{self.n}", q, self._dh, law, self._links, self._legs, self.gravity)[0]
+
+    def bias(self, q, qd) -> np.ndarray:
+        """(..., n): C(θ, θ')θ' + g(θ)."""
+        (q, qd), law = self._state(q, qd)
+        return call(f"bias{self.n}", q, qd, self._dh, law, self._links, self._legs, self.gravity)[0]
+
+    def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
+        """(..., n): τ = M(θ)θ'' + C(θ, θ')θ' + g(θ), torques about the pair axes."""
+        (q, qd, qdd), law = self._state(q, qd, qdd)
+        return call(f"inverse_dynamics{self.n}", q, qd, qdd, self._dh, law, self._links, self._legs,
+                    self.gravity)[0]
+
+    def forward_dynamics(self, q, qd, tau) -> np.ndarray:
+        """(..., n): θ'' = M⁻¹(τ − C θ' − g), by a Cholesky factorisation of M (batched)."""
+        (q, qd, tau), law = self._state(q, qd, tau)
+        M = call(f"mass_matrix{self.n}", q, self._dh, law, self._links, self._legs)[0]
+        b = call(f"bias{self.n}", q, qd, self._dh, law, self._links, self._legs, self.gravity)[0]
+        try:
+            L = np.linalg.cholesky(M)
+        except np.linalg.LinAlgError:
+            raise ValueError("links: the mass matrix is not positive definite at this q "
+                             "(give every moving body mass and inertia)") from None
+        rhs = (tau - b)[..., None]
+        y = np.linalg.solve(L, rhs)
+        return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
+
+    def energy(self, q, qd) -> np.ndarray:
+        """(..., 2): kinetic and potential energy (T, V) [J], legs included."""
+        (q, qd), law = self._state(q, qd)
+        return call(f"energy{self.n}", q, qd, self._dh, law, self._links, self._legs, self.gravity)[0]
+
+    def simulate(self, q0, qd0, t, tau=None, rtol=1e-10, atol=1e-12, method="DOP853"):
+        """Integrate the equations of motion from (q0, qd0) and report the state at times `t`.
+
+        tau: None (free motion), an array (n,), or a callable tau(t, q, qd) -> (n,).
+        Adaptive Runge-Kutta (scipy.integrate.solve_ivp) over the generated kernels.
+        Returns a `Trajectory` with t, q, qd, and the energies T, V along it.
+        """
+        from .simulate import simulate
+
+        return simulate(self, q0, qd0, t, tau, rtol=rtol, atol=atol, method=method)

@@ -11,6 +11,11 @@
     alpha = 1.5707963267948966     # DH twist [rad], or alpha_deg = 90
     offset = 0.0                   # c_i [m] (optional)
     theta_offset = 0.0             # phi_i [rad] (optional), or theta_offset_deg
+    mass = 1.0                     # link i (optional): mass [kg], centre of mass in frame i [m],
+    com = [0.0, 0.0, 0.05]         # inertia about the centre of mass in frame i [kg m^2]:
+    inertia = [0.01, 0.01, 0.02]   # principal (Ixx, Iyy, Izz), six values (Ixx, Iyy, Izz, Ixy,
+                                   # Ixz, Iyz) or a 3x3 table
+    gravity = [0, 0, -9.81]        # top level, optional [m/s^2]
 """
 from __future__ import annotations
 
@@ -18,7 +23,10 @@ import math
 import tomllib
 from pathlib import Path
 
+import numpy as np
+
 from .chain import AChain
+from .link import Link
 from .pair import KINDS, APair
 
 _PAIR_KEYS = {
@@ -27,6 +35,29 @@ _PAIR_KEYS = {
     "revolute": set(),
 }
 _DH_KEYS = {"a", "alpha", "alpha_deg", "offset", "theta_offset", "theta_offset_deg"}
+_LINK_KEYS = {"mass", "com", "inertia"}
+
+
+def _numbers(where: str, v, shapes):
+    arr = np.asarray(v, dtype=object)
+    if arr.shape not in shapes or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in arr.flat):
+        raise ValueError(f"{where}: expected numbers of shape {' or '.join(map(str, shapes))}, got {v!r}")
+    return np.asarray(v, dtype=float)
+
+
+def _link(w: str, j: dict) -> Link:
+    mass = _number(f"{w}.mass", j.get("mass", 0.0))
+    com = _numbers(f"{w}.com", j.get("com", [0.0, 0.0, 0.0]), [(3,)])
+    I = _numbers(f"{w}.inertia", j.get("inertia", [0.0, 0.0, 0.0]), [(3,), (6,), (3, 3)])
+    if I.shape == (3,):
+        I = np.diag(I)
+    elif I.shape == (6,):
+        xx, yy, zz, xy, xz, yz = I
+        I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    try:
+        return Link(mass, com, I)
+    except ValueError as exc:
+        raise ValueError(f"{w}.{exc}") from None
 
 
 def _angle(where: str, j: dict, key: str, default=None):
@@ -51,13 +82,13 @@ def _number(where: str, v):
 
 def chain_from_dict(data: dict, where: str = "chain") -> AChain:
     """Build an AChain from the parsed TOML document."""
-    unknown = set(data) - {"name", "joint", "description"}
+    unknown = set(data) - {"name", "joint", "description", "gravity"}
     if unknown:
         raise ValueError(f"{where}: unknown keys {sorted(unknown)}")
     joints = data.get("joint")
     if not isinstance(joints, list) or not joints:
         raise ValueError(f"{where}: needs at least one [[joint]] table")
-    pairs, a, alpha, offset, theta_offset = [], [], [], [], []
+    pairs, a, alpha, offset, theta_offset, links = [], [], [], [], [], []
     for i, j in enumerate(joints):
         w = f"{where}: joint[{i}]"
         if not isinstance(j, dict):
@@ -65,7 +96,7 @@ def chain_from_dict(data: dict, where: str = "chain") -> AChain:
         kind = j.get("pair")
         if kind not in KINDS:
             raise ValueError(f"{w}.pair: expected one of {KINDS}, got {kind!r}")
-        allowed = _PAIR_KEYS[kind] | _DH_KEYS | {"pair"}
+        allowed = _PAIR_KEYS[kind] | _DH_KEYS | _LINK_KEYS | {"pair"}
         unknown = set(j) - allowed
         if unknown:
             raise ValueError(f"{w}: keys {sorted(unknown)} are not valid for a {kind} pair")
@@ -86,8 +117,10 @@ def chain_from_dict(data: dict, where: str = "chain") -> AChain:
         alpha.append(_angle(w, j, "alpha"))
         offset.append(_number(f"{w}.offset", j.get("offset", 0.0)))
         theta_offset.append(_angle(w, j, "theta_offset", 0.0))
+        links.append(_link(w, j))
+    gravity = _numbers(f"{where}: gravity", data.get("gravity", [0.0, 0.0, -9.81]), [(3,)])
     try:
-        return AChain(pairs, a, alpha, offset, theta_offset)
+        return AChain(pairs, a, alpha, offset, theta_offset, links=links, gravity=gravity)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
 
