@@ -6,11 +6,16 @@ import sys
 import time
 from pathlib import Path
 
-from derivations import apair_pair, chain_dynamics, chain_kinematics
+from derivations import apair_dynamics, apair_pair, chain_dynamics, chain_kinematics
 
 from .emitter import Emitter, write
 
-DERIVATIONS = {"apair_pair": apair_pair, "chain_kinematics": chain_kinematics, "chain_dynamics": chain_dynamics}
+DERIVATIONS = {
+    "apair_pair": apair_pair,
+    "apair_dynamics": apair_dynamics,
+    "chain_kinematics": chain_kinematics,
+    "chain_dynamics": chain_dynamics,
+}
 ROOT = Path(__file__).resolve().parent.parent
 
 

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: b2dc4f0a25274b9d
+Content hash: ba0d3c61deb5abbd
 """

@@ -7,13 +7,13 @@ import pytest
 import sympy as sp
 
 import apair
-from derivations import apair_pair, chain_kinematics
+from codegen.__main__ import DERIVATIONS
 
 
 @pytest.fixture(scope="session")
 def derivations():
     """{module name: (polynomial sets, kernel specs, facts)}, derived afresh once per session."""
-    return {mod.__name__.split(".")[-1]: mod.derive() for mod in (apair_pair, chain_kinematics)}
+    return {name: mod.derive() for name, mod in DERIVATIONS.items()}
 
 
 @pytest.fixture(scope="session")
@@ -33,28 +33,43 @@ def backend(request):
 
 
 def evaluate_spec(spec, inputs: list[np.ndarray], digits: int = 40) -> list[np.ndarray]:
-    """Reference values of a spec at one point, step by step in `digits`-digit arithmetic.
+    """Reference values of a spec at a batch of points, step by step in `digits`-digit arithmetic.
 
-    Each step and output is lambdified on its own (small expressions) and evaluated in order, so
-    the reference follows the derivation and shares nothing with CSE, printers or templates.
+    `inputs` carry a leading batch axis. Each step and output is lambdified on its own (small
+    expressions) and evaluated in order on object arrays of mpmath numbers, so the reference
+    follows the derivation and shares nothing with CSE, printers or templates.
     """
+    count = len(inputs[0])
     with mpmath.workdps(digits):
         env = {}
         for arg, x in zip(spec.inputs, inputs):
-            for s, v in zip(arg.symbols, np.asarray(x, dtype=float).ravel()):
-                env[s] = mpmath.mpf(float(v))
+            flat = np.asarray(x, dtype=float).reshape(count, -1)
+            for k, s in enumerate(arg.symbols):
+                env[s] = np.array([mpmath.mpf(float(v)) for v in flat[:, k]], dtype=object)
         for sym, expr in spec.steps:
-            env[sym] = _eval(expr, env)
-        return [np.array([float(_eval(sp.S(e), env)) for e in a.exprs]).reshape(a.shape) for a in spec.outputs]
+            env[sym] = _eval(expr, env, count)
+        outs = []
+        for a in spec.outputs:
+            cols = [_eval(sp.S(e), env, count) for e in a.exprs]
+            outs.append(np.array([[float(c[i]) for c in cols] for i in range(count)]).reshape((count,) + a.shape))
+        return outs
 
 
+def _vectorised(fn):
+    return np.frompyfunc(fn, 1, 1)
+
+
+_MODULE = {name: _vectorised(getattr(mpmath, name)) for name in ("cos", "sin", "tan", "sqrt", "acos", "asin", "atan", "exp", "log")}
 _CACHE: dict = {}
 
 
-def _eval(expr, env):
+def _eval(expr, env, count):
     syms = tuple(sorted(expr.free_symbols, key=str))
     key = (expr, syms)
     fn = _CACHE.get(key)
     if fn is None:
-        fn = _CACHE[key] = sp.lambdify(syms, expr, modules="mpmath")
-    return fn(*[env[s] for s in syms])
+        fn = _CACHE[key] = sp.lambdify(syms, expr, modules=[_MODULE, "mpmath"])
+    out = fn(*[env[s] for s in syms])
+    if not isinstance(out, np.ndarray):
+        out = np.full(count, mpmath.mpf(out), dtype=object)
+    return out

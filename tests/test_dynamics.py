@@ -224,3 +224,29 @@ def test_simulate_with_torque_does_work():
     assert traj.energy[-1] == pytest.approx(1.0 * (traj.q[-1, 0] - traj.q[0, 0]), rel=1e-7)
     const = chain.simulate(np.zeros(2), np.zeros(2), t, tau=[1.0, 0.0])
     np.testing.assert_allclose(const.q, traj.q, atol=1e-9)
+
+
+@pytest.mark.parametrize("kind", ["sinusoidal", "general"])
+def test_single_pair_closed_form_equals_the_chain(kind, backend):
+    """The Lagrange closed form of one pair (derivations/apair_dynamics.py) and the chain recursion
+    for n = 1, with legs."""
+    rng = np.random.default_rng(600)
+    for _ in range(5):
+        r_b, r_p = rng.uniform(0.05, 0.3, 2)
+        ml = rng.uniform(0.05, 0.5)
+        if kind == "sinusoidal":
+            p = apair.APair(r_b, r_p, leg_mass=ml)
+        else:
+            b = r_b * r_p
+            p = apair.APair(r_b, r_p, leg_length=np.sqrt(b * rng.uniform(0.2, 3.0) + r_b**2 + r_p**2 / 4), leg_mass=ml)
+        link = random_link(rng)
+        g = rng.uniform(1, 20)
+        chain = apair.AChain([p], [0.0], [0.0], links=[link], gravity=[0, 0, -g])
+        lim = p.theta_limit or np.pi
+        theta = rng.uniform(-0.95, 0.95, 20) * lim
+        qd, qdd = rng.normal(size=20), rng.normal(size=20)
+        terms = p.dynamics(theta, qd, qdd, platform=link, g=g)
+        tau = chain.inverse_dynamics(theta[:, None], qd[:, None], qdd[:, None])[:, 0]
+        np.testing.assert_allclose(terms[:, 0], tau, rtol=1e-11, atol=1e-12)
+        np.testing.assert_allclose(terms[:, 1], chain.mass_matrix(theta[:, None])[:, 0, 0], rtol=1e-11)
+        np.testing.assert_allclose(terms[:, 3], chain.gravity_torques(theta[:, None])[:, 0], rtol=1e-11, atol=1e-12)

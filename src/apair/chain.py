@@ -92,14 +92,16 @@ class AChain:
         return self._kernel("jacobian", q, law)
 
     # ----------------------------------------------------------------------------- dynamics
-    def _state(self, q, qd=None, qdd=None):
-        """Validated (q, qd, qdd, law) broadcast to one batch shape."""
+    def _state(self, q, **named):
+        """Validated q and the named (n,)-arrays (qd, qdd, tau), broadcast to one batch shape; and
+        the joint law values at q."""
         q = self._q(q)
-        arrays = [q] + [self._q(x, name) for x, name in ((qd, "qd"), (qdd, "qdd")) if x is not None]
+        arrays = [q] + [self._q(x, name) for name, x in named.items()]
         try:
             shape = np.broadcast_shapes(*(x.shape for x in arrays))
         except ValueError:
-            raise ValueError(f"qd: batch shape does not match q: {[x.shape for x in arrays]}") from None
+            first = next(iter(named))
+            raise ValueError(f"{first}: batch shape does not match q: {[x.shape for x in arrays]}") from None
         arrays = [np.broadcast_to(x, shape) for x in arrays]
         law = self.law(arrays[0])
         if np.any(~np.isfinite(law)):
@@ -113,7 +115,7 @@ class AChain:
 
     def coriolis_matrix(self, q, qd) -> np.ndarray:
         """(..., n, n): C(θ, θ') in Christoffel form (Ṁ − 2C is skew-symmetric)."""
-        (q, qd), law = self._state(q, qd)
+        (q, qd), law = self._state(q, qd=qd)
         return call(f"coriolis{self.n}", q, qd, self._dh, law, self._links, self._legs)[0]
 
     def gravity_torques(self, q) -> np.ndarray:
@@ -123,18 +125,18 @@ class AChain:
 
     def bias(self, q, qd) -> np.ndarray:
         """(..., n): C(θ, θ')θ' + g(θ)."""
-        (q, qd), law = self._state(q, qd)
+        (q, qd), law = self._state(q, qd=qd)
         return call(f"bias{self.n}", q, qd, self._dh, law, self._links, self._legs, self.gravity)[0]
 
     def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
         """(..., n): τ = M(θ)θ'' + C(θ, θ')θ' + g(θ), torques about the pair axes."""
-        (q, qd, qdd), law = self._state(q, qd, qdd)
+        (q, qd, qdd), law = self._state(q, qd=qd, qdd=qdd)
         return call(f"inverse_dynamics{self.n}", q, qd, qdd, self._dh, law, self._links, self._legs,
                     self.gravity)[0]
 
     def forward_dynamics(self, q, qd, tau) -> np.ndarray:
         """(..., n): θ'' = M⁻¹(τ − C θ' − g), by a Cholesky factorisation of M (batched)."""
-        (q, qd, tau), law = self._state(q, qd, tau)
+        (q, qd, tau), law = self._state(q, qd=qd, tau=tau)
         M = call(f"mass_matrix{self.n}", q, self._dh, law, self._links, self._legs)[0]
         b = call(f"bias{self.n}", q, qd, self._dh, law, self._links, self._legs, self.gravity)[0]
         try:
@@ -148,7 +150,7 @@ class AChain:
 
     def energy(self, q, qd) -> np.ndarray:
         """(..., 2): kinetic and potential energy (T, V) [J], legs included."""
-        (q, qd), law = self._state(q, qd)
+        (q, qd), law = self._state(q, qd=qd)
         return call(f"energy{self.n}", q, qd, self._dh, law, self._links, self._legs, self.gravity)[0]
 
     def simulate(self, q0, qd0, t, tau=None, rtol=1e-10, atol=1e-12, method="DOP853"):

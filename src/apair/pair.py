@@ -112,6 +112,30 @@ class APair:
         d = self.law(theta)[..., 0]
         return float(d) if d.ndim == 0 else d
 
+    def dynamics(self, theta, qd=0.0, qdd=0.0, platform=None, g=9.81) -> np.ndarray:
+        """(..., 4): (τ, J, J'/2, G) of this pair alone with a vertical axis and gravity g along −z:
+        τ = J(θ)θ'' + ½J'(θ)θ'² + G(θ). `platform` is a Link in the platform frame (default: none),
+        the legs are this pair's. See `apair show apair_dynamics` for the closed forms."""
+        from .link import Link
+
+        if platform is None:
+            platform = Link(0.0)
+        if not isinstance(platform, Link):
+            raise ValueError(f"platform: expected a Link, got {type(platform).__name__}")
+        th = self._theta(theta)
+        qd = V.real_array("qd", qd)
+        qdd = V.real_array("qdd", qdd)
+        g = V.scalar("g", g)
+        shape = np.broadcast_shapes(th.shape, qd.shape, qdd.shape)
+        th, qd, qdd = (np.broadcast_to(x, shape) for x in (th, qd, qdd))
+        law = self._law(th)
+        if np.any(~np.isfinite(law)):
+            raise ValueError("theta: at the pair's limit, where d'(theta) is unbounded")
+        row = platform.as_row()
+        plat = np.array([row[0], row[1], row[2], row[3], row[6]])
+        legs = np.array([self.leg_mass, self.base_radius, self.platform_radius])
+        return call("pair_dynamics", th[..., None], qd[..., None], qdd[..., None], law, plat, legs, [g])[0]
+
     def leg_endpoints(self, theta) -> np.ndarray:
         """(..., 6, 2, 3): [base point, platform point] of each leg in the pair's base frame."""
         th = self._theta(theta)
