@@ -163,3 +163,17 @@ class AChain:
         from .simulate import simulate
 
         return simulate(self, q0, qd0, t, tau, rtol=rtol, atol=atol, method=method)
+
+    # ----------------------------------------------------------------------------- varieties
+    def constraint_variety(self, max_degree: int = 4, seed: int = 0):
+        """2-pair chains: homogeneous sympy.Poly in x0..y3 (the Study quadric included) that
+        generate every form of degree ≤ max_degree vanishing on all poses of the chain.
+
+        The result is a list with `.degree`, `.hilbert`, `.dims`, `.exact` and `.residual`
+        (see apair.variety): exact for rational designs, floating point otherwise.
+        """
+        from .variety import constraint_variety
+
+        if not isinstance(max_degree, int) or not 1 <= max_degree <= 4:
+            raise ValueError(f"max_degree: expected an integer from 1 to 4, got {max_degree!r}")
+        return constraint_variety(self, max_degree=max_degree, seed=seed)

@@ -73,6 +73,27 @@ def _cmd_demo(args) -> int:
     return 0
 
 
+def _cmd_variety(args) -> int:
+    import sympy as sp
+
+    chain = load(args.file)
+    V = chain.constraint_variety()
+    if args.json:
+        print(json.dumps({
+            "chain": chain.name, "exact": V.exact, "degree": V.degree, "residual": V.residual,
+            "hilbert": V.hilbert, "dims": V.dims,
+            "equations": [{"degree": P.total_degree(), "terms": len(P.terms()), "expr": sp.sstr(P.as_expr())} for P in V],
+        }, indent=1))
+        return 0
+    kind = "exact" if V.exact else f"floating point, residual {V.residual:.2e}"
+    print(f"{chain.name}: constraint variety ({kind}); surface of degree {V.degree}")
+    print("Hilbert function: " + ", ".join(f"HF({k}) = {v}" for k, v in V.hilbert.items()))
+    for i, P in enumerate(V):
+        body = sp.latex(P.as_expr()) if args.latex else sp.sstr(P.as_expr())
+        print(f"[{i}] degree {P.total_degree()}, {len(P.terms())} terms\n  {body}")
+    return 0
+
+
 def _cmd_kernels(args) -> int:
     for name, k in sorted(manifest()["kernels"].items()):
         ins = ", ".join(f"{a['name']}{tuple(a['shape'])}" for a in k["inputs"])
@@ -98,6 +119,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("q", nargs="+", metavar="Q", help="joint angles (radians unless --deg)")
     p.add_argument("--deg", action="store_true", help="angles in degrees")
     p.set_defaults(func=_cmd_fk)
+    p = sub.add_parser("variety", help="the constraint variety of a 2-pair chain file")
+    p.add_argument("file", help="a chain TOML file with two joints")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--latex", action="store_true", help="equations in LaTeX")
+    g.add_argument("--json", action="store_true", help="machine-readable")
+    p.set_defaults(func=_cmd_variety)
     p = sub.add_parser("kernels", help="list the generated kernels with their operation counts")
     p.set_defaults(func=_cmd_kernels)
     p = sub.add_parser("demo", help="print the derived A-pair law and, given a chain file, one pose")

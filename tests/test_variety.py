@@ -1,0 +1,134 @@
+"""Constraint varieties of 2-joint chains: vanishing, non-vanishing, the Hilbert function and the
+degree, each checked by something independent of the computation."""
+from __future__ import annotations
+
+import json
+import random
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import apair
+from apair import variety as V
+from apair.cli import main
+
+X = V.VARS
+
+
+def chain_2a():
+    return apair.AChain([apair.APair(0.1, 0.05), apair.APair(0.1, 0.05)], [0.3, 0.25], [np.pi / 2, 0.0], [0.1, 0.0])
+
+
+def chain_2r():
+    return apair.AChain([apair.APair.revolute(), apair.APair.revolute()], [0.3, 0.25], [np.pi / 2, 0.0], [0.1, 0.0])
+
+
+@pytest.fixture(scope="module")
+def var2a():
+    return chain_2a().constraint_variety()
+
+
+def values(V_, S):
+    fns = [sp.lambdify(X, P.as_expr(), "numpy") for P in V_]
+    return np.array([f(*S.T) for f in fns])
+
+
+def random_poses(chain, count, seed):
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(-np.pi, np.pi, (count, 2))
+    for i, p in enumerate(chain.pairs):
+        if p.theta_limit is not None:
+            q[:, i] = rng.uniform(-0.98, 0.98, count) * p.theta_limit
+    return chain.fk_study(q)
+
+
+def test_2r_is_a_quadric_in_a_3_space():
+    W = chain_2r().constraint_variety()
+    assert W.exact and W.degree == 2
+    assert [P.total_degree() for P in W] == [1, 1, 1, 1, 2]
+    assert all(W.hilbert[k] == (k + 1) ** 2 for k in range(7))  # a quadric surface in P^3
+
+
+def test_equations_vanish_on_poses_and_not_elsewhere(var2a):
+    chain = chain_2a()
+    assert var2a.exact and var2a.degree == 24
+    assert [P.total_degree() for P in var2a][:4] == [2, 2, 2, 2]
+    assert any(P.as_expr() == X[0] * X[4] + X[1] * X[5] + X[2] * X[6] + X[3] * X[7] for P in var2a)
+    S = random_poses(chain, 1000, 1)
+    vals = values(var2a, S)
+    scale = np.array([max(abs(float(c)) for c in P.coeffs()) for P in var2a])[:, None]
+    assert np.max(np.abs(vals) / scale) < 1e-9
+    # random points of the Study quadric (y chosen orthogonal to x) are not on the surface
+    rng = np.random.default_rng(2)
+    x = rng.normal(size=(50, 4))
+    y = rng.normal(size=(50, 4))
+    y -= (np.sum(x * y, axis=1) / np.sum(x * x, axis=1))[:, None] * x
+    off = np.concatenate([x, y], axis=1)
+    off /= np.linalg.norm(off, axis=1, keepdims=True)
+    assert np.all(np.max(np.abs(values(var2a, off)) / scale, axis=0) > 1e-4)
+
+
+def test_hilbert_function_from_independent_samples(var2a):
+    """Ranks of the monomial matrices at other sample points (other seed) give the same values."""
+    js, exact = V.designs(chain_2a())
+    pts = V._sample_exact(js, 400, random.Random(99))
+    for k in (1, 2, 3, 4):
+        mons = V.monomials(k)
+        assert V._rank_mod_p(V._monomial_rows_mod_p(pts[: len(mons) + 30], mons).tolist()) == var2a.hilbert[k]
+
+
+def test_degree_by_counting_points_on_two_hyperplanes():
+    """Two random hyperplanes meet the surface in deg points: solve for (u1, u2) by a resultant."""
+    js, _ = V.designs(chain_2a())
+    u1, u2 = sp.symbols("u1 u2")
+    conv = lambda f: sp.Rational(f.numerator, f.denominator)
+
+    def joint(j, u):
+        jj = V.JointDesign(j.kind, conv(j.h), conv(j.a), conv(j.c), tuple(map(conv, j.alpha)), tuple(map(conv, j.phi)))
+        return V._constant_factors(jj, V._rational_quartic(jj.h, u), sp.Integer(1), sp.Integer(0))
+
+    P = [sp.expand(c) for c in V._smul(joint(js[0], u1), joint(js[1], u2))]
+    rng = random.Random(3)
+    L = [sum(rng.randint(-9, 9) * c for c in P) for _ in range(2)]
+    sq = sp.Poly(sp.sqf_part(sp.resultant(L[0], L[1], u2)), u1)
+    f = sp.lambdify((u1, u2), P, "numpy")
+    found = []
+    for a in np.roots([complex(c) for c in sq.all_coeffs()]):
+        for b in np.roots([complex(c) for c in sp.Poly(L[0].subs(u1, a), u2).all_coeffs()]):
+            if abs(complex(L[1].subs({u1: a, u2: b}))) < 1e-6 * max(1, abs(b)) ** 8:
+                p = np.array(f(a, b), dtype=complex)
+                if np.linalg.norm(p) < 1e-9:
+                    continue
+                p = p / p[np.argmax(np.abs(p))]
+                if not any(np.linalg.norm(p - q) < 1e-6 for q in found):
+                    found.append(p)
+    assert len(found) == 24
+
+
+def test_float_variant_for_a_general_pair():
+    chain = apair.AChain([apair.APair(0.1, 0.05, leg_length=0.12), apair.APair.revolute()], [0.3, 0.25], [np.pi / 2, 0.0])
+    W = chain.constraint_variety(max_degree=2)
+    assert not W.exact and W.residual < 1e-10
+    assert W.dims[2] >= 1  # at least the Study quadric
+    S = random_poses(chain, 200, 5)
+    vals = values(W, S / np.linalg.norm(S, axis=1, keepdims=True))
+    assert np.max(np.abs(vals)) < 1e-9
+
+
+def test_variety_inputs(tmp_path):
+    with pytest.raises(ValueError, match=r"^chain: constraint varieties are computed for 2-pair chains"):
+        apair.AChain([apair.APair.revolute()] * 3, [0.1] * 3, [0.0] * 3).constraint_variety()
+    with pytest.raises(ValueError, match=r"^max_degree:"):
+        chain_2r().constraint_variety(max_degree=7)
+
+
+def test_cli_variety(capsys, tmp_path):
+    path = tmp_path / "c.toml"
+    path.write_text("[[joint]]\npair = \"revolute\"\na = 0.3\nalpha_deg = 90\noffset = 0.1\n"
+                    "[[joint]]\npair = \"revolute\"\na = 0.25\nalpha = 0\n")
+    assert main(["variety", str(path), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["exact"] and data["degree"] == 2 and len(data["equations"]) == 5
+    assert main(["variety", str(path)]) == 0
+    assert "surface of degree 2" in capsys.readouterr().out
