@@ -12,9 +12,11 @@ geometry (derivations/apair_pair.py):
     S_k = (z_{k−1}, o_{k−1} × z_{k−1} + d'_k z_{k−1})   (the joint screw, pitch d'_k),
 
 so M_kl = S_kᵀ 𝕄^c_{max(k,l)} S_l + S_kᵀ Y_{max(k+1,l)} S_l + S_lᵀ Y_{max(l+1,k)} S_k with composite
-sums 𝕄^c_j = Σ_{j'≥j} 𝕄_j', Y_m = Σ_{i≥m} X_i (a CRBA with leg couplings). g = ∂V/∂θ and the
-Christoffel symbols of M come from forward-mode differentiation of these steps
-(derivations/autodiff.py), with d/dθ_k of the law values (d, d', d'') → (d', d'', ·).
+sums 𝕄^c_j = Σ_{j'≥j} 𝕄_j', Y_m = Σ_{i≥m} X_i (a CRBA with leg couplings). The inverse dynamics,
+bias and gravity torques come from a Newton-Euler recursion with the same bodies and leg couplings
+(`rnea`), and C from the Christoffel symbols of M by forward-mode differentiation of these steps
+(derivations/autodiff.py), with d/dθ_k of the law values (d, d', d'') → (d', d'', ·). `check_bias`
+proves the recursion equal to the Lagrangian Ṁθ' − ∇(T − V) at random points.
 """
 from __future__ import annotations
 
@@ -199,6 +201,14 @@ class Assembly:
         w, v = self.S[k - 1]
         return w.col_join(v)
 
+    def velocity_tangent(self) -> dict:
+        """d/dt of the inputs along the motion: θ_k → θ'_k, d_k → d'_k θ'_k, d'_k → d''_k θ'_k."""
+        tangent = {}
+        for k, j in enumerate(self.J, start=1):
+            for s, v in self.seeds(k).items():
+                tangent[s] = tangent.get(s, 0) + v * j["qd"]
+        return tangent
+
     def seeds(self, k: int) -> dict:
         """d/dθ_k of the inputs: θ_k → 1 and, through the law, d_k → d'_k, d'_k → d''_k."""
         j = self.J[k - 1]
@@ -283,11 +293,7 @@ def rnea(asm: Assembly, qd, qdd, gravity: bool, prefix: str):
 def lagrangian_bias(asm: Assembly):
     """The same bias by another route: Ṁθ' − ∇_θ(T − V), T = ½ θ'ᵀMθ' (forward + reverse mode)."""
     qd = sp.Matrix([j["qd"] for j in asm.J])
-    tangent = {}
-    for k, j in enumerate(asm.J, start=1):
-        for s, v in asm.seeds(k).items():
-            tangent[s] = tangent.get(s, 0) + v * j["qd"]
-    f_steps, Mdot = directional(asm.rec.steps, list(asm.M), tangent, "dMt_")
+    f_steps, Mdot = directional(asm.rec.steps, list(asm.M), asm.velocity_tangent(), "dMt_")
     L = (qd.T * asm.M * qd)[0] / 2 - asm.V
     r_steps, grads = gradient(asm.rec.steps, L, "aL_")
     bias = sp.Matrix(asm.n, asm.n, Mdot) * qd - sp.Matrix([_through_law(asm, grads, k) for k in range(1, asm.n + 1)])
@@ -301,11 +307,7 @@ def christoffel(asm: Assembly):
     along each θ_j."""
     n = asm.n
     qd = [j["qd"] for j in asm.J]
-    tangent = {}
-    for k, j in enumerate(asm.J, start=1):
-        for s, v in asm.seeds(k).items():
-            tangent[s] = tangent.get(s, 0) + v * j["qd"]
-    steps, Mdot = directional(asm.rec.steps, list(asm.M), tangent, "dMt_")
+    steps, Mdot = directional(asm.rec.steps, list(asm.M), asm.velocity_tangent(), "dMt_")
     Mdot = sp.Matrix(n, n, Mdot)
     mu_steps, Mu = rnea(asm, [0] * n, qd, gravity=False, prefix="mu_")
     steps += mu_steps

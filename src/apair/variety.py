@@ -135,7 +135,7 @@ def _pair_point_exact(j: JointDesign, u: Fraction):
     if j.kind == "revolute":
         P = (one, zero, zero, u, zero, zero, zero, zero)  # u = tan(θ/2)
     else:
-        P = tuple(Fraction(int(c.p), int(c.q)) if False else c for c in _rational_quartic(j.h, u))
+        P = _rational_quartic(j.h, u)
     return _constant_factors(j, P, one, zero)
 
 
