@@ -132,3 +132,14 @@ def test_cli_variety(capsys, tmp_path):
     assert data["exact"] and data["degree"] == 2 and len(data["equations"]) == 5
     assert main(["variety", str(path)]) == 0
     assert "surface of degree 2" in capsys.readouterr().out
+
+
+def test_float_variant_agrees_with_the_exact_one(var2a):
+    """For a rational design, the SVD route on poses from the kernels spans the exact forms."""
+    W = V._constraint_variety_float(chain_2a(), 3, seed=1)
+    assert not W.exact and W.residual < 1e-9
+    assert W.dims[2] == var2a.dims[2] and W.dims[3] == var2a.dims[3]
+    assert [P.total_degree() for P in W] == [P.total_degree() for P in var2a if P.total_degree() <= 3]
+    S = random_poses(chain_2a(), 300, 8)
+    S = S / np.linalg.norm(S, axis=1, keepdims=True)
+    assert np.max(np.abs(values(W, S))) < 1e-9
