@@ -81,3 +81,16 @@ def test_batched_broadcasts_shared_inputs(backend):
     grid = call("fk3", theta.reshape(11, 1, 3), dh, law.reshape(11, 1, 3, 3))[0]
     assert grid.shape == (11, 1, 4, 4)
     np.testing.assert_array_equal(grid[:, 0], shared)
+
+
+def test_non_contiguous_inputs(backend):
+    """Strided views and Fortran-ordered arrays give the same results as contiguous copies."""
+    rng = np.random.default_rng(11)
+    big = rng.uniform(-3, 3, (20, 6))
+    theta = big[:, ::2]  # a strided view, (20, 3)
+    dh = np.asfortranarray(rng.uniform(-1, 1, (3, 4)))
+    law = np.asfortranarray(rng.uniform(-1, 1, (20, 3, 3)))
+    got = call("jacobian3", theta, dh, law)[0]
+    want = call("jacobian3", np.ascontiguousarray(theta), np.ascontiguousarray(dh), np.ascontiguousarray(law))[0]
+    np.testing.assert_array_equal(got, want)
+    assert got.shape == (20, 6, 3)
