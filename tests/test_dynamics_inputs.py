@@ -88,6 +88,8 @@ def test_pair_dynamics_inputs():
         p.dynamics(0.1, qd=np.nan)
     with pytest.raises(ValueError, match=r"^g:"):
         p.dynamics(0.1, g=[1, 2])
+    with pytest.raises(ValueError, match=r"^qd: shapes"):
+        p.dynamics(np.zeros(3), qd=np.zeros(4))
     out = p.dynamics(np.linspace(-1, 1, 7), qd=1.0)
     assert out.shape == (7, 4)
 

@@ -126,7 +126,10 @@ class APair:
         qd = V.real_array("qd", qd)
         qdd = V.real_array("qdd", qdd)
         g = V.scalar("g", g)
-        shape = np.broadcast_shapes(th.shape, qd.shape, qdd.shape)
+        try:
+            shape = np.broadcast_shapes(th.shape, qd.shape, qdd.shape)
+        except ValueError:
+            raise ValueError(f"qd: shapes {th.shape}, {qd.shape}, {qdd.shape} of theta, qd, qdd do not broadcast") from None
         th, qd, qdd = (np.broadcast_to(x, shape) for x in (th, qd, qdd))
         law = self._law(th)
         if np.any(~np.isfinite(law)):
