@@ -8,7 +8,7 @@ DEPS_STAMP := $(VENV)/.deps-stamp
 CFLAGS_STRICT := -std=c99 -Wall -Wextra -Werror -pedantic -O2
 CHECK_DIR := build/check-generated
 
-.PHONY: all venv generate install lib demo check test clean
+.PHONY: all venv generate install lib demo check test bench clean
 
 all: generate install lib demo
 
@@ -48,6 +48,10 @@ check: $(DEPS_STAMP)
 
 test: check install lib
 	$(PY) -m pytest -q
+
+# Timings (never asserted by tests): results in bench/results.json.
+bench: install
+	$(PY) bench/run.py
 
 clean:
 	rm -rf build .venv *.egg-info src/*.egg-info

@@ -129,6 +129,9 @@ def test_demo_without_file(capsys):
     (["show", "nope", "--json"], "show", r"name: no derived polynomial set 'nope'"),
     (["fk", EXAMPLES / "missing.toml", "0.1"], "fk", r"path: no such file .*missing\.toml"),
     (["demo", EXAMPLES / "missing.toml"], "demo", r"path: no such file .*missing\.toml"),
+    (["ik", CHAIN4, "1", "0", "0"], "ik", r"POSE: expected 16 \(or 12\) numbers"),
+    (["ik", CHAIN4, *"1 0 0 0 0 1 0 0 0 0 1 x".split()], "ik", r"POSE: 'x' is not a number"),
+    (["ik", CHAIN4, *"1 0 0 0 0 1 0 0 0 0 2 0".split()], "ik", r"T: the rotation part is not a proper rotation"),
 ])
 def test_error_exits(capsys, argv, command, message):
     code, out, err = run(capsys, *argv)
@@ -155,3 +158,28 @@ def test_module_entry_point():
     assert bad.returncode == 2 and "apair show: error: name:" in bad.stderr
     ver = subprocess.run([sys.executable, "-m", "apair", "--version"], capture_output=True, text=True, timeout=120)
     assert ver.returncode == 0 and ver.stdout.strip() == f"apair {apair.__version__}"
+
+
+@pytest.mark.parametrize("form", ["matrix", "rows", "study"])
+def test_ik_reachable(capsys, form):
+    chain = apair.load(CHAIN4)
+    q = np.array([0.3, -0.5, 0.8, 1.1])
+    T = chain.fk(q)
+    pose = {"matrix": T.ravel(), "rows": T[:3].ravel(), "study": chain.fk_study(q)}[form]
+    code, out, err = run(capsys, "ik", CHAIN4, *[repr(float(x)) for x in pose], "--deg")
+    assert code == 0 and err == ""
+    assert "1 real solution(s) of 1 complex" in out
+    found = np.array([float(x) for x in re.findall(NUMBER, out.split("q = [", 1)[1].split("]", 1)[0])])
+    np.testing.assert_allclose(found, q, atol=1e-9)
+
+
+def test_ik_unreachable_says_how_far(capsys):
+    chain = apair.load(CHAIN4)
+    T = chain.fk([0.3, -0.5, 0.8, 1.1])
+    T[2, 3] += 0.05
+    code, out, err = run(capsys, "ik", CHAIN4, *[repr(float(x)) for x in T.ravel()])
+    assert code == 1 and err == ""
+    m = re.search(rf"unreachable. The nearest pose found .* is ({NUMBER}) m and ({NUMBER}) rad away", out)
+    assert m, out
+    assert 0 < float(m.group(1)) <= 0.05 + 1e-9
+

@@ -177,3 +177,22 @@ class AChain:
         if not isinstance(max_degree, int) or not 1 <= max_degree <= 4:
             raise ValueError(f"max_degree: expected an integer from 1 to 4, got {max_degree!r}")
         return constraint_variety(self, max_degree=max_degree, seed=seed)
+
+    # ----------------------------------------------------------------------------- inverse kinematics
+    def ik(self, T, tol: float = 1e-9, full: bool = False):
+        """All real joint vectors q (k, n) with fk(q) = T, each verified (largest entry of
+        |fk(q) − T| ≤ tol); (0, n) when T is out of reach. T: a 4×4 transform or a Study point.
+
+        Chains of 1 to 4 sinusoidal A-pairs or R-pairs, by kinematic mapping (see apair.ik): the
+        left half's constraint variety on the right part's image, eliminated to eigenvalue and
+        univariate problems. Angles in (−2π, 2π] for A-pairs, (−π, π] for R-pairs.
+        full=True returns an `apair.ik.Solution` (q, error, candidates, complex_count).
+        """
+        from .ik import Solver
+
+        tol = V.scalar("tol", tol, positive=True)
+        if getattr(self, "_ik", None) is None:
+            self._ik = Solver(self)
+        sol = self._ik.solve(T, tol=tol, count_complex=full)
+        return sol if full else sol.q
+

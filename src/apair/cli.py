@@ -94,6 +94,43 @@ def _cmd_variety(args) -> int:
     return 0
 
 
+def _parse_pose(values) -> np.ndarray:
+    x = []
+    for v in values:
+        try:
+            x.append(float(v))
+        except ValueError:
+            raise ValueError(f"POSE: {v!r} is not a number") from None
+    if len(x) == 16:
+        return np.array(x).reshape(4, 4)
+    if len(x) == 12:  # the top three rows of the transform
+        return np.vstack([np.array(x).reshape(3, 4), [0.0, 0.0, 0.0, 1.0]])
+    if len(x) == 8:
+        return np.array(x)
+    raise ValueError(f"POSE: expected 16 (or 12) numbers of a 4x4 transform, row by row, or the 8 of a "
+                     f"Study point, got {len(x)}")
+
+
+def _cmd_ik(args) -> int:
+    from .ik import distance
+
+    chain = load(args.file)
+    T = _parse_pose(args.pose)
+    sol = chain.ik(T, full=True)
+    with np.printoptions(precision=12, suppress=True, floatmode="maxprec"):
+        if len(sol.q) == 0:
+            dp, dr, q = distance(chain, T)
+            print(f"{chain.name}: the pose is unreachable. The nearest pose found (q = {q} rad) is "
+                  f"{dp:.3e} m and {dr:.3e} rad away.")
+            return 1
+        print(f"{chain.name}: {len(sol.q)} real solution(s) of {sol.complex_count} complex; "
+              f"angles in rad{' and deg' if args.deg else ''}")
+        for q, e in zip(sol.q, sol.error):
+            extra = f"  = {np.degrees(q)} deg" if args.deg else ""
+            print(f"  q = {q}{extra}   |fk(q) - T| = {e:.1e}")
+    return 0
+
+
 def _cmd_kernels(args) -> int:
     for name, k in sorted(manifest()["kernels"].items()):
         ins = ", ".join(f"{a['name']}{tuple(a['shape'])}" for a in k["inputs"])
@@ -125,6 +162,12 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--latex", action="store_true", help="equations in LaTeX")
     g.add_argument("--json", action="store_true", help="machine-readable")
     p.set_defaults(func=_cmd_variety)
+    p = sub.add_parser("ik", help="all inverse kinematics solutions of a chain file at a pose")
+    p.add_argument("file", help="a chain TOML file (1 to 4 sinusoidal A-pairs or R-pairs)")
+    p.add_argument("pose", nargs="+", metavar="POSE",
+                   help="a 4x4 transform row by row (16 numbers, or the top 12) or a Study point (8)")
+    p.add_argument("--deg", action="store_true", help="also print the angles in degrees")
+    p.set_defaults(func=_cmd_ik)
     p = sub.add_parser("kernels", help="list the generated kernels with their operation counts")
     p.set_defaults(func=_cmd_kernels)
     p = sub.add_parser("demo", help="print the derived A-pair law and, given a chain file, one pose")

@@ -62,3 +62,28 @@ def from_matrix(T) -> np.ndarray:
         t1 * b - t2 * a + t3 * w,
     ], -1)
     return np.concatenate([x, y], -1)
+
+
+def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    a0, a1, a2, a3 = np.moveaxis(a, -1, 0)
+    b0, b1, b2, b3 = np.moveaxis(b, -1, 0)
+    return np.stack([a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+                     a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+                     a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+                     a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0], -1)
+
+
+def multiply(p, q) -> np.ndarray:
+    """Dual-quaternion product of (..., 8) Study points (broadcasting; real or complex):
+    (x1 + εy1)(x2 + εy2) = x1x2 + ε(x1y2 + y1x2), the point of T1·T2."""
+    p, q = np.asarray(p), np.asarray(q)
+    return np.concatenate([_qmul(p[..., :4], q[..., :4]),
+                           _qmul(p[..., :4], q[..., 4:]) + _qmul(p[..., 4:], q[..., :4])], -1)
+
+
+_CONJ = np.array([1.0, -1.0, -1.0, -1.0, 1.0, -1.0, -1.0, -1.0])
+
+
+def conjugate(p) -> np.ndarray:
+    """(x̃, ỹ): projectively the inverse displacement of a point on the Study quadric."""
+    return np.asarray(p) * _CONJ

@@ -1,0 +1,180 @@
+"""Inverse kinematics by kinematic mapping (apair.ik): completeness, exactness, clear failures."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import least_squares
+
+import apair
+from apair.study import from_matrix
+
+
+def random_chain(rng, n, kinds="s") -> apair.AChain:
+    pairs = [apair.APair.revolute() if kinds[i % len(kinds)] == "r" else apair.APair(*rng.uniform(0.03, 0.1, 2))
+             for i in range(n)]
+    return apair.AChain(pairs, rng.uniform(0.1, 0.4, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.1, 0.1, n),
+                        rng.uniform(-1.0, 1.0, n))
+
+
+def periods(chain):
+    return np.array([2 * np.pi if p.kind == "revolute" else 4 * np.pi for p in chain.pairs])
+
+
+def contains(sols, q, per, tol=1e-8) -> bool:
+    d = np.abs((sols - q + per / 2) % per - per / 2)
+    return bool(len(sols)) and bool(np.any(np.all(d < tol, axis=1)))
+
+
+def assert_reproduce(chain, sols, T, tol=1e-9):
+    if len(sols):
+        assert np.abs(chain.fk(sols) - T).max() <= tol
+
+
+def test_round_trip_random_4a_designs():
+    """≥ 200 random joint vectors on 40 random 4A designs: ik(fk(q)) contains q, every solution is exact."""
+    rng = np.random.default_rng(2026)
+    found = 0
+    for _ in range(40):
+        chain = random_chain(rng, 4)
+        for q in rng.uniform(-2 * np.pi, 2 * np.pi, (5, 4)):
+            T = chain.fk(q)
+            sols = chain.ik(T)
+            assert sols.shape[1] == 4
+            assert_reproduce(chain, sols, T)
+            found += contains(sols, q, periods(chain))
+    assert found == 200
+
+
+@pytest.mark.parametrize("n, kinds", [(1, "s"), (1, "r"), (2, "s"), (2, "r"), (2, "sr"), (3, "s"), (3, "rs"),
+                                      (4, "r"), (4, "sr"), (4, "ssrs")])
+def test_round_trip_mixed_chains(n, kinds):
+    rng = np.random.default_rng(n * 100 + len(kinds))
+    for _ in range(8):
+        chain = random_chain(rng, n, kinds)
+        q = rng.uniform(-np.pi, np.pi, n)
+        T = chain.fk(q)
+        sols = chain.ik(T)
+        assert contains(sols, q, periods(chain))
+        assert_reproduce(chain, sols, T)
+
+
+def test_study_point_input_and_example_chain():
+    chain = apair.load("examples/4a_chain.toml")  # parallel axes 2, 3, 4: the degenerate-rotation path
+    q = np.array([0.3, -0.5, 0.8, 1.1])
+    T = chain.fk(q)
+    for pose in (T, chain.fk_study(q), -3.0 * chain.fk_study(q)):
+        sols = chain.ik(pose)
+        assert contains(sols, q, periods(chain))
+        assert_reproduce(chain, sols, T)
+
+
+def test_generic_counts_are_one_complex_one_real():
+    """For generic designs and poses the map from joint space onto its image is birational: the
+    elimination finds exactly one complex solution, and it is the real one we started from."""
+    rng = np.random.default_rng(11)
+    for n, kinds in ((2, "s"), (3, "s"), (4, "s"), (4, "sr")):
+        chain = random_chain(rng, n, kinds)
+        sol = chain.ik(chain.fk(rng.uniform(-3, 3, n)), full=True)
+        assert (len(sol.q), sol.complex_count) == (1, 1)
+
+
+def test_a_pair_at_half_turn_gives_both_branches():
+    """θ = π and θ = −π give the same joint transform for an A-pair (d = 0, equal rotations):
+    both are solutions and both are returned."""
+    rng = np.random.default_rng(5)
+    chain = random_chain(rng, 4)
+    q = np.array([np.pi, 0.4, -0.9, 1.3])
+    sols = chain.ik(chain.fk(q))
+    assert contains(sols, q, periods(chain))
+    assert contains(sols, q - [2 * np.pi, 0, 0, 0], periods(chain))
+    assert_reproduce(chain, sols, chain.fk(q))
+
+
+def multistart(chain, T, starts, rng):
+    """Dense multi-start least squares: the distinct joint vectors that reach T to 1e-10."""
+    per = periods(chain)
+
+    def residual(q):
+        F = chain.fk(q)
+        return np.concatenate([(F[:3, 3] - T[:3, 3]) / 0.3, (F[:3, :3] - T[:3, :3]).ravel()])
+
+    out = []
+    for q0 in rng.uniform(-per / 2, per / 2, (starts, chain.n)):
+        r = least_squares(residual, q0, xtol=1e-15, ftol=1e-15, gtol=1e-15)
+        if np.abs(r.fun).max() < 1e-10 and not contains(np.array(out).reshape(-1, chain.n), r.x, per, 1e-6):
+            out.append((r.x + per / 2) % per - per / 2)
+    return np.array(out).reshape(-1, chain.n)
+
+
+def test_no_solution_missed_against_multistart():
+    rng = np.random.default_rng(99)
+    for n, kinds in ((4, "s"), (4, "sr"), (2, "s"), (3, "s")):
+        for _ in range(2):
+            chain = random_chain(rng, n, kinds)
+            T = chain.fk(rng.uniform(-3, 3, n))
+            sols = chain.ik(T)
+            for q in multistart(chain, T, 40, rng):
+                assert contains(sols, q, periods(chain), 1e-6), (q, sols)
+
+
+def test_unreachable_poses_give_no_solution():
+    rng = np.random.default_rng(3)
+    for n in (1, 2, 3, 4):
+        chain = random_chain(rng, n)
+        T = chain.fk(rng.uniform(-3, 3, n))
+        T[:3, 3] += [0.01, -0.02, 0.015]
+        assert chain.ik(T).shape == (0, n)
+    chain = random_chain(rng, 4)
+    T = np.eye(4)
+    T[:3, 3] = [5.0, 0.0, 0.0]  # far beyond the reach
+    assert chain.ik(T).shape == (0, 4)
+
+
+def test_near_singular_pose_is_solved_or_refused_never_wrong():
+    """Poses next to a singularity (σ_min(J) small): each returned q reproduces the pose."""
+    rng = np.random.default_rng(8)
+    chain = random_chain(rng, 2)
+    # a 2-joint chain is singular where its two screws are linearly dependent: sample the smallest σ
+    Q = rng.uniform(-np.pi, np.pi, (4000, 2))
+    sig = np.linalg.svd(chain.jacobian(Q), compute_uv=False)[:, -1]
+    for q in Q[np.argsort(sig)[:5]]:
+        T = chain.fk(q)
+        sols = chain.ik(T)
+        assert_reproduce(chain, sols, T)
+        assert contains(sols, q, periods(chain))
+
+
+@pytest.mark.parametrize("T, message", [
+    (np.eye(3), r"T: expected a 4x4 transform or an 8-vector Study point"),
+    (np.full((4, 4), np.nan), r"T: contains NaN"),
+    (np.diag([1.0, 1.0, 2.0, 1.0]), r"T: the rotation part is not a proper rotation"),
+    (np.diag([1.0, 1.0, -1.0, 1.0]), r"T: the rotation part is not a proper rotation"),
+    (np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]), r"T: last row"),
+    (np.array([1.0, 0, 0, 0, 1.0, 0, 0, 0]), r"T: not on the Study quadric"),
+    (np.zeros(8), r"T: a Study point with x = 0"),
+])
+def test_bad_pose(T, message):
+    chain = random_chain(np.random.default_rng(0), 2)
+    with pytest.raises(ValueError, match=message):
+        chain.ik(T)
+
+
+def test_unsupported_chains():
+    rng = np.random.default_rng(1)
+    general = apair.APair(0.05, 0.04, leg_length=0.068)
+    chain = apair.AChain([general, apair.APair(0.05, 0.05)], [0.2, 0.2], [1.0, 0.5])
+    with pytest.raises(ValueError, match=r"pairs\[0\]: a general A-pair"):
+        chain.ik(np.eye(4))
+    with pytest.raises(ValueError, match=r"chain: inverse kinematics covers chains of 1 to 4 pairs"):
+        random_chain(rng, 5).ik(np.eye(4))
+    with pytest.raises(ValueError, match=r"tol: must be > 0"):
+        random_chain(rng, 2).ik(np.eye(4), tol=0.0)
+
+
+def test_matrix_and_study_conversions_agree():
+    rng = np.random.default_rng(4)
+    chain = random_chain(rng, 4)
+    q = rng.uniform(-3, 3, 4)
+    a = chain.ik(chain.fk(q))
+    b = chain.ik(from_matrix(chain.fk(q)))
+    np.testing.assert_allclose(a, b, atol=1e-9)
