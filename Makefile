@@ -8,9 +8,9 @@ DEPS_STAMP := $(VENV)/.deps-stamp
 CFLAGS_STRICT := -std=c99 -Wall -Wextra -Werror -pedantic -O2
 CHECK_DIR := build/check-generated
 
-.PHONY: all venv generate install lib demo check test bench clean
+.PHONY: all venv generate install varieties lib demo check test bench clean
 
-all: generate install lib demo
+all: generate install varieties lib demo
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -26,6 +26,10 @@ venv: $(DEPS_STAMP)
 generate: $(DEPS_STAMP)
 	PYTHONPATH=. $(PY) -m codegen
 
+# The example chains' constraint varieties (exact), computed by the installed runtime's engine.
+varieties: install
+	PYTHONPATH=. $(PY) -m codegen.varieties
+
 # Non-editable install of the runtime with the current generated/ (builds the C kernels too).
 install: $(DEPS_STAMP)
 	$(PY) -m pip install --quiet --no-deps --no-build-isolation --force-reinstall .
@@ -40,13 +44,14 @@ demo: install
 	$(BIN)/apair demo examples/4a_chain.toml
 
 # Regenerate into a scratch folder and fail if it differs from the committed generated/.
-check: $(DEPS_STAMP)
+check: install
 	rm -rf $(CHECK_DIR)
 	PYTHONPATH=. $(PY) -m codegen --out $(CHECK_DIR)
+	PYTHONPATH=. $(PY) -m codegen.varieties --out $(CHECK_DIR)
 	diff -r -x __pycache__ generated $(CHECK_DIR) || \
 	  (echo "generated/ is out of date with the derivations: run make generate and commit" >&2; exit 1)
 
-test: check install lib
+test: install lib check
 	$(PY) -m pytest -q
 
 # Timings (never asserted by tests): results in bench/results.json.

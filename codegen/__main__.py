@@ -9,6 +9,7 @@ from pathlib import Path
 from derivations import apair_dynamics, apair_pair, chain_dynamics, chain_kinematics
 
 from .emitter import Emitter, write
+from .varieties import PREFIX as VARIETY_PREFIX
 
 DERIVATIONS = {
     "apair_pair": apair_pair,
@@ -35,7 +36,7 @@ def main(argv=None) -> int:
               f"({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
     t0 = time.perf_counter()
     files = Emitter().render(groups, poly_sets)
-    changed = write(files, args.out, clean=args.only is None)
+    changed = write(files, args.out, clean=args.only is None, keep=(f"polynomials/{VARIETY_PREFIX}",))
     print(f"emitted {len(files)} files ({time.perf_counter() - t0:.1f} s); changed: {len(changed)}", file=sys.stderr)
     for c in changed:
         print(f"  {c}", file=sys.stderr)

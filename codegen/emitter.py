@@ -182,8 +182,9 @@ class Emitter:
         return files
 
 
-def write(files: dict[str, str], out: Path, clean: bool = True) -> list[str]:
-    """Write files under `out`; with `clean`, remove generated files no longer produced. Returns changes."""
+def write(files: dict[str, str], out: Path, clean: bool = True, keep: tuple[str, ...] = ()) -> list[str]:
+    """Write files under `out`; with `clean`, remove generated files no longer produced (except
+    those whose path starts with one of `keep`: another step writes them). Returns changes."""
     changed = []
     out.mkdir(parents=True, exist_ok=True)
     for rel, text in sorted(files.items()):
@@ -195,7 +196,7 @@ def write(files: dict[str, str], out: Path, clean: bool = True) -> list[str]:
     if clean:
         for path in sorted(out.rglob("*")):
             rel = path.relative_to(out).as_posix()
-            if path.is_file() and rel not in files and "__pycache__" not in rel:
+            if path.is_file() and rel not in files and "__pycache__" not in rel and not rel.startswith(keep):
                 path.unlink()
                 changed.append(f"removed {rel}")
     return changed

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import random
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -143,3 +144,23 @@ def test_float_variant_agrees_with_the_exact_one(var2a):
     S = random_poses(chain_2a(), 300, 8)
     S = S / np.linalg.norm(S, axis=1, keepdims=True)
     assert np.max(np.abs(values(W, S))) < 1e-9
+
+
+def test_example_variety_in_generated_vanishes_on_its_poses():
+    """generated/polynomials/variety_2a_chain (written by codegen.varieties) holds on 1000 poses of
+    examples/2a_chain.toml and not on random points of the Study quadric."""
+    eqs = apair.polynomials.load("variety_2a_chain")
+    xs = sp.symbols("x0 x1 x2 x3 y0 y1 y2 y3", real=True)
+    fns = [sp.lambdify(xs, e, "numpy") for e in eqs.values()]
+    size = np.array([sum(abs(float(c)) for c in sp.Poly(e, *xs).coeffs()) for e in eqs.values()])[:, None]
+    chain = apair.load(Path(__file__).parent.parent / "examples" / "2a_chain.toml")
+    rng = np.random.default_rng(5)
+    S = chain.fk_study(rng.uniform(-2 * np.pi, 2 * np.pi, (1000, 2)))
+    vals = np.array([f(*S.T) for f in fns]) / size  # the points have |x| = 1 and |y| < 1
+    assert np.abs(vals).max() < 1e-13
+    R = rng.standard_normal((200, 8))
+    x, y = R[:, :4], R[:, 4:]
+    R[:, 4:] = y - (np.sum(x * y, 1) / np.sum(x * x, 1))[:, None] * x  # onto the Study quadric
+    R /= np.linalg.norm(R, axis=1, keepdims=True)
+    far = np.abs(np.array([f(*R.T) for f in fns]) / size).max(axis=0)
+    assert far.min() > 1e-6

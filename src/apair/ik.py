@@ -38,7 +38,7 @@ import numpy as np
 import scipy.linalg
 
 from . import _validate as V
-from .study import conjugate, from_matrix, multiply, normalise
+from .study import _qmul, conjugate, from_matrix, multiply, normalise, to_matrix
 
 SEED = 46  # fixed: the parameter shifts and random combinations are reproducible
 OUTSIDE = [1, 2, 5, 6]  # components that vanish on the pair subalgebra
@@ -167,7 +167,7 @@ def _joint(chain, i: int, scale: float, delta: float) -> _Joint:
             raise AssertionError("the pair's rotation part lost its (1 + u^2) factor")
         x = np.stack([np.pad(q, (0, 3 - len(q))) for q, _ in parts], 1)
     K = multiply(_trans(0, chain.a[i] / scale), _rot(0, chain.alpha[i]))
-    return _Joint(pair.kind, delta, P, _qmul_np(x, K[:4]), K, conjugate(K))
+    return _Joint(pair.kind, delta, P, _qmul(x, K[:4]), K, conjugate(K))
 
 
 class _Degenerate(Exception):
@@ -213,7 +213,7 @@ class Solver:
         if n == 4:
             j3, j4 = self.joints[2:]
             self.image = conjugate(multiply(j3.A[:, None, :], j4.A[None, :, :]))
-            self.ximage = _qconj(_qmul_np(j3.xhat[:, None, :], j4.xhat[None, :, :]))
+            self.ximage = _qconj(_qmul(j3.xhat[:, None, :], j4.xhat[None, :, :]))
         if n >= 3:
             Q, Qx = self._half_quadrics()
             if len(Qx) == 0:
@@ -235,7 +235,6 @@ class Solver:
     # -- per pose
     def solve(self, T: np.ndarray, tol: float = 1e-9, count_complex: bool = False) -> Solution:
         target = _study(T)
-        target = target.copy()
         target[4:] /= self.scale
         n = self.chain.n
         try:
@@ -332,12 +331,6 @@ def _eval(coeffs: np.ndarray, u: np.ndarray) -> np.ndarray:
 
 def _qconj(x):
     return x * np.array([1.0, -1.0, -1.0, -1.0])
-
-
-def _qmul_np(a, b):
-    from .study import _qmul
-
-    return _qmul(np.asarray(a), np.asarray(b))
 
 
 def _quadric_forms(pts: np.ndarray) -> np.ndarray:
@@ -471,8 +464,6 @@ def _check_matrix(T: np.ndarray) -> np.ndarray:
 
 
 def _matrix(T) -> np.ndarray:
-    from .study import to_matrix
-
     T = np.asarray(T, dtype=float)
     return T if T.shape == (4, 4) else to_matrix(normalise(T))
 
@@ -525,7 +516,8 @@ def distance(chain, T, starts: int = 24, seed: int = 0) -> tuple[float, float, n
     length scale). An estimate for reporting unreachable poses, not part of the exact solver."""
     from scipy.optimize import least_squares
 
-    Tm = _matrix(_matrix_input(T))
+    _study(T)  # validates
+    Tm = _matrix(T)
     lengths = [abs(x) for x in (*chain.a, *chain.offset)] + [p.amplitude for p in chain.pairs]
     scale = max(max(lengths), 1e-3)
     rng = np.random.default_rng(seed)
@@ -549,8 +541,3 @@ def distance(chain, T, starts: int = 24, seed: int = 0) -> tuple[float, float, n
     q = best.x - periods * np.ceil((best.x - periods / 2) / periods)
     return dp, float(np.arccos(np.clip(c, -1.0, 1.0))), q
 
-
-def _matrix_input(T) -> np.ndarray:
-    """Validated pose (as given) for `distance`: 4×4 or a Study point."""
-    _study(T)
-    return np.asarray(T, dtype=float)

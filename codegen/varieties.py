@@ -1,0 +1,75 @@
+"""`python -m codegen.varieties [--out DIR]`: the constraint varieties of the example 2-pair chains.
+
+Each example in examples/ with two joints and rational constants gets its variety computed exactly
+by the installed runtime's engine (apair.variety: FLINT nullspaces on points of the chain's
+rational image) and written, like every derived set, as generated/polynomials/variety_<stem>.{txt,
+tex,json}; `apair show variety_2a_chain` prints it. This runs after `make install` (the engine is
+part of the runtime); `python -m codegen` leaves these files in place.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import sympy as sp
+
+from derivations.spec import Entry, PolynomialSet
+
+from .emitter import Emitter, write
+from .polynomials import render_polynomial_set
+
+ROOT = Path(__file__).resolve().parent.parent
+PREFIX = "variety_"
+
+
+def variety_set(path: Path) -> PolynomialSet | None:
+    """The example's variety as a polynomial set, or None when it is not an exact 2-pair case."""
+    import apair
+    from apair.variety import VARS
+
+    chain = apair.load(path)
+    if chain.n != 2:
+        return None
+    V = chain.constraint_variety()
+    if not V.exact:
+        return None
+    x = sp.symbols("x0 x1 x2 x3 y0 y1 y2 y3", real=True)
+    entries = []
+    for i, P in enumerate(V):
+        expr = P.as_expr().subs(dict(zip(VARS, x)))
+        entries.append(Entry(f"F{i}", expr, tuple(x), note=f"degree {P.total_degree()}"))
+    hf = ", ".join(f"HF({k}) = {v}" for k, v in V.hilbert.items())
+    return PolynomialSet(
+        name=f"{PREFIX}{path.stem}",
+        title=f"Constraint variety of {chain.name} ({path.name}) in Study parameters",
+        source=f"examples/{path.name} by codegen/varieties.py (the exact engine apair.variety)",
+        description=(f"Homogeneous forms in x0..y3 generating every form of degree <= 4 that vanishes on all "
+                     f"poses of the chain (the Study quadric included). A surface of degree {V.degree}; "
+                     f"Hilbert function {hf}."),
+        entries=entries,
+    )
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m codegen.varieties", description=__doc__)
+    ap.add_argument("--out", type=Path, default=ROOT / "generated", help="output folder (default: generated/)")
+    args = ap.parse_args(argv)
+    files = {}
+    emitter = Emitter()
+    for path in sorted((ROOT / "examples").glob("*.toml")):
+        t0 = time.perf_counter()
+        ps = variety_set(path)
+        if ps is not None:
+            files.update(render_polynomial_set(ps, emitter._hash))
+            print(f"variety of {path.name}: {len(ps.entries)} equations ({time.perf_counter() - t0:.1f} s)",
+                  file=sys.stderr)
+    changed = write(files, args.out, clean=False)
+    for c in changed:
+        print(f"  {c}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
