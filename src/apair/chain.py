@@ -195,4 +195,3 @@ class AChain:
             self._ik = Solver(self)
         sol = self._ik.solve(T, tol=tol, count_complex=full)
         return sol if full else sol.q
-
