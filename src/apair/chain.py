@@ -53,6 +53,7 @@ class AChain:
         self.gravity = V.vector("gravity", gravity, 3)
         self._links = np.ascontiguousarray(np.stack([link.as_row() for link in links]))
         self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pairs])
+        self._ik = None  # the inverse-kinematics solver, built on the first call of ik()
 
     @property
     def n(self) -> int:
@@ -191,7 +192,7 @@ class AChain:
         from .ik import Solver
 
         tol = V.scalar("tol", tol, positive=True)
-        if getattr(self, "_ik", None) is None:
+        if self._ik is None:
             self._ik = Solver(self)
         sol = self._ik.solve(T, tol=tol, count_complex=full)
         return sol if full else sol.q

@@ -111,6 +111,23 @@ def _quartic() -> np.ndarray:
     return out
 
 
+# ----------------------------------------------------------------------------- chain constants
+def _scale(chain) -> float:
+    """The chain's length scale: its largest link length, offset or amplitude (at least 1 mm)."""
+    lengths = [abs(x) for x in (*chain.a, *chain.offset)] + [p.amplitude for p in chain.pairs]
+    return max(max(lengths), 1e-3)
+
+
+def _periods(chain) -> np.ndarray:
+    """Each joint's period in θ: 2π for an R-pair, 4π for an A-pair (d changes sign at θ + 2π)."""
+    return np.array([2 * np.pi if p.kind == "revolute" else 4 * np.pi for p in chain.pairs])
+
+
+def _wrap(theta, period):
+    """θ into (−period/2, period/2]."""
+    return theta - period * np.ceil((theta - period / 2) / period)
+
+
 # ----------------------------------------------------------------------------- joints
 def _rot(axis: int, angle: float) -> np.ndarray:
     p = np.zeros(8)
@@ -142,10 +159,8 @@ class _Joint:
 
     def theta(self, u):
         if self.kind == "revolute":
-            th = 2 * np.arctan(u) + self.delta
-            return th - 2 * np.pi * np.ceil((th - np.pi) / (2 * np.pi))
-        th = 4 * np.arctan(u) + self.delta
-        return th - 4 * np.pi * np.ceil((th - 2 * np.pi) / (4 * np.pi))
+            return _wrap(2 * np.arctan(u) + self.delta, 2 * np.pi)
+        return _wrap(4 * np.arctan(u) + self.delta, 4 * np.pi)
 
 
 def _joint(chain, i: int, scale: float, delta: float) -> _Joint:
@@ -200,8 +215,7 @@ class Solver:
                 raise ValueError(f"pairs[{i}]: a general A-pair's motion is not rational; inverse kinematics "
                                  "needs sinusoidal A-pairs or R-pairs")
         self.chain = chain
-        lengths = [abs(x) for x in (*chain.a, *chain.offset)] + [p.amplitude for p in chain.pairs]
-        self.scale = max(max(lengths), 1e-3)
+        self.scale = _scale(chain)
         self.rng = np.random.default_rng(seed)
         self.joints = [_joint(chain, i, self.scale, self.rng.uniform(-np.pi, np.pi)) for i in range(n)]
         j1 = self.joints[0]
@@ -489,8 +503,8 @@ def _refine(chain, q: np.ndarray, T: np.ndarray, tol: float):
         e2, err2 = error(q2)
         better = err2 < err
         q, e, err = np.where(better[:, None], q2, q), np.where(better[:, None], e2, e), np.where(better, err2, err)
-    periods = np.array([2 * np.pi if p.kind == "revolute" else 4 * np.pi for p in chain.pairs])
-    q = q - periods * np.ceil((q - periods / 2) / periods)
+    periods = _periods(chain)
+    q = _wrap(q, periods)
     keep = err <= tol
     q, err = q[keep], err[keep]
     order = np.argsort(err, kind="stable")
@@ -518,11 +532,11 @@ def distance(chain, T, starts: int = 24, seed: int = 0) -> tuple[float, float, n
 
     _study(T)  # validates
     Tm = _matrix(T)
-    lengths = [abs(x) for x in (*chain.a, *chain.offset)] + [p.amplitude for p in chain.pairs]
-    scale = max(max(lengths), 1e-3)
+    scale = _scale(chain)
     rng = np.random.default_rng(seed)
-    periods = np.array([2 * np.pi if p.kind == "revolute" else 4 * np.pi for p in chain.pairs])
+    periods = _periods(chain)
     lo = np.array([-(p.theta_limit or per / 2) for p, per in zip(chain.pairs, periods)])
+    bounds = (lo, -lo) if any(p.theta_limit for p in chain.pairs) else (-np.inf, np.inf)
 
     def residual(q):
         F = chain.fk(q)
@@ -531,13 +545,11 @@ def distance(chain, T, starts: int = 24, seed: int = 0) -> tuple[float, float, n
     best = None
     for _ in range(starts):
         q0 = rng.uniform(lo, -lo) * 0.999
-        bounds = (lo, -lo) if any(p.theta_limit for p in chain.pairs) else (-np.inf, np.inf)
         r = least_squares(residual, q0, bounds=bounds, xtol=1e-14, ftol=1e-14)
         if best is None or r.cost < best.cost:
             best = r
     F = chain.fk(best.x)
     dp = float(np.linalg.norm(F[:3, 3] - Tm[:3, 3]))
     c = (np.trace(F[:3, :3].T @ Tm[:3, :3]) - 1) / 2
-    q = best.x - periods * np.ceil((best.x - periods / 2) / periods)
-    return dp, float(np.arccos(np.clip(c, -1.0, 1.0))), q
+    return dp, float(np.arccos(np.clip(c, -1.0, 1.0))), _wrap(best.x, periods)
 
