@@ -27,14 +27,19 @@ def _cmd_show(args) -> int:
     return 0
 
 
-def _parse_angles(values, deg: bool) -> np.ndarray:
-    q = []
+def _parse_numbers(name: str, values) -> np.ndarray:
+    """Command-line words as floats; a word that is not a number is an error naming `name`."""
+    out = []
     for v in values:
         try:
-            q.append(float(v))
+            out.append(float(v))
         except ValueError:
-            raise ValueError(f"Q: {v!r} is not a number") from None
-    q = np.array(q)
+            raise ValueError(f"{name}: {v!r} is not a number") from None
+    return np.array(out)
+
+
+def _parse_angles(values, deg: bool) -> np.ndarray:
+    q = _parse_numbers("Q", values)
     return np.radians(q) if deg else q
 
 
@@ -95,18 +100,13 @@ def _cmd_variety(args) -> int:
 
 
 def _parse_pose(values) -> np.ndarray:
-    x = []
-    for v in values:
-        try:
-            x.append(float(v))
-        except ValueError:
-            raise ValueError(f"POSE: {v!r} is not a number") from None
+    x = _parse_numbers("POSE", values)
     if len(x) == 16:
-        return np.array(x).reshape(4, 4)
+        return x.reshape(4, 4)
     if len(x) == 12:  # the top three rows of the transform
-        return np.vstack([np.array(x).reshape(3, 4), [0.0, 0.0, 0.0, 1.0]])
+        return np.vstack([x.reshape(3, 4), [0.0, 0.0, 0.0, 1.0]])
     if len(x) == 8:
-        return np.array(x)
+        return x
     raise ValueError(f"POSE: expected 16 (or 12) numbers of a 4x4 transform, row by row, or the 8 of a "
                      f"Study point, got {len(x)}")
 
