@@ -134,13 +134,6 @@ class Emitter:
     def _template(self, name: str) -> tuple[jinja2.Template, str]:
         return self.env.get_template(name), (TEMPLATES / name).read_text()
 
-    def _hash(self, parts: list[str]) -> str:
-        h = hashlib.sha256()
-        for p in parts:
-            h.update(p.encode())
-            h.update(b"\0")
-        return h.hexdigest()[:16]
-
     def render(self, groups: dict[str, list[KernelSpec]], poly_sets: list[PolynomialSet]) -> dict[str, str]:
         """groups: {derivation module stem: its kernel specs} -> {path under generated/: text}."""
         files: dict[str, str] = {}
@@ -151,14 +144,14 @@ class Emitter:
         header_t, header_src = self._template("apair.h.j2")
         src_t, src_src = self._template("kernels.c.j2")
         py_t, py_src = self._template("kernels.py.j2")
-        header_hash = self._hash([header_src] + [fingerprints[k.name] for k in all_kernels])
+        header_hash = content_hash([header_src] + [fingerprints[k.name] for k in all_kernels])
         sources = sorted({k.spec.source for k in all_kernels})
         files["c/apair.h"] = header_t.render(kernels=all_kernels, hash=header_hash, sources=sources, prefix=PREFIX)
         manifest = {"content_hash": header_hash, "prefix": PREFIX, "kernels": {}}
         for stem, ks in lowered.items():
             source = ks[0].spec.source
-            c_hash = self._hash([src_src] + [fingerprints[k.name] for k in ks])
-            py_hash = self._hash([py_src] + [fingerprints[k.name] for k in ks])
+            c_hash = content_hash([src_src] + [fingerprints[k.name] for k in ks])
+            py_hash = content_hash([py_src] + [fingerprints[k.name] for k in ks])
             files[f"c/{stem}.c"] = src_t.render(kernels=ks, source=source, hash=c_hash, prefix=PREFIX)
             files[f"numpy/{stem}.py"] = py_t.render(kernels=ks, source=source, hash=py_hash)
             for k in ks:
@@ -178,8 +171,17 @@ class Emitter:
         files["__init__.py"] = (f'"""Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.\n\n'
                                 f'Content hash: {header_hash}\n"""\n')
         for ps in poly_sets:
-            files.update(render_polynomial_set(ps, self._hash))
+            files.update(render_polynomial_set(ps, content_hash))
         return files
+
+
+def content_hash(parts: list[str]) -> str:
+    """The 16-hex-digit SHA-256 of the parts (NUL-separated) that a generated file is made from."""
+    h = hashlib.sha256()
+    for p in parts:
+        h.update(p.encode())
+        h.update(b"\0")
+    return h.hexdigest()[:16]
 
 
 def write(files: dict[str, str], out: Path, clean: bool = True, keep: tuple[str, ...] = ()) -> list[str]:

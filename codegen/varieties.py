@@ -13,11 +13,9 @@ import sys
 import time
 from pathlib import Path
 
-import sympy as sp
-
 from derivations.spec import Entry, PolynomialSet
 
-from .emitter import Emitter, write
+from .emitter import content_hash, write
 from .polynomials import render_polynomial_set
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -35,11 +33,7 @@ def variety_set(path: Path) -> PolynomialSet | None:
     V = chain.constraint_variety()
     if not V.exact:
         return None
-    x = sp.symbols("x0 x1 x2 x3 y0 y1 y2 y3", real=True)
-    entries = []
-    for i, P in enumerate(V):
-        expr = P.as_expr().subs(dict(zip(VARS, x)))
-        entries.append(Entry(f"F{i}", expr, tuple(x), note=f"degree {P.total_degree()}"))
+    entries = [Entry(f"F{i}", P.as_expr(), tuple(VARS), note=f"degree {P.total_degree()}") for i, P in enumerate(V)]
     hf = ", ".join(f"HF({k}) = {v}" for k, v in V.hilbert.items())
     return PolynomialSet(
         name=f"{PREFIX}{path.stem}",
@@ -57,12 +51,11 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=ROOT / "generated", help="output folder (default: generated/)")
     args = ap.parse_args(argv)
     files = {}
-    emitter = Emitter()
     for path in sorted((ROOT / "examples").glob("*.toml")):
         t0 = time.perf_counter()
         ps = variety_set(path)
         if ps is not None:
-            files.update(render_polynomial_set(ps, emitter._hash))
+            files.update(render_polynomial_set(ps, content_hash))
             print(f"variety of {path.name}: {len(ps.entries)} equations ({time.perf_counter() - t0:.1f} s)",
                   file=sys.stderr)
     changed = write(files, args.out, clean=False)
