@@ -6,7 +6,7 @@ import sys
 import time
 from pathlib import Path
 
-from derivations import apair_dynamics, apair_pair, chain_dynamics, chain_kinematics
+from derivations import apair_dynamics, apair_pair, chain_dynamics, chain_kinematics, chain_variety
 
 from .emitter import Emitter, write
 from .varieties import PREFIX as VARIETY_PREFIX
@@ -16,6 +16,7 @@ DERIVATIONS = {
     "apair_dynamics": apair_dynamics,
     "chain_kinematics": chain_kinematics,
     "chain_dynamics": chain_dynamics,
+    "chain_variety": chain_variety,
 }
 ROOT = Path(__file__).resolve().parent.parent
 

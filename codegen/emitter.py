@@ -137,7 +137,7 @@ class Emitter:
     def render(self, groups: dict[str, list[KernelSpec]], poly_sets: list[PolynomialSet]) -> dict[str, str]:
         """groups: {derivation module stem: its kernel specs} -> {path under generated/: text}."""
         files: dict[str, str] = {}
-        lowered = {stem: [lower(s) for s in specs] for stem, specs in groups.items()}
+        lowered = {stem: [lower(s) for s in specs] for stem, specs in groups.items() if specs}  # skip set-only ones
         all_kernels = [k for ks in lowered.values() for k in ks]
         fingerprints = {k.name: k.spec.fingerprint() for k in all_kernels}
 

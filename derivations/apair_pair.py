@@ -70,6 +70,28 @@ def pair_study_point(angle, shift):
     return rotation((0, 0, 1), sp.cos(angle / 2), sp.sin(angle / 2)) * translation((0, 0, shift))
 
 
+SINUSOIDAL_LAW = h * sp.cos(theta / 2)  # d(θ) of a sinusoidal pair, proved in `derive`
+
+
+def rational_motion(law=SINUSOIDAL_LAW) -> list[sp.Expr]:
+    """The sinusoidal pair's Study point as polynomials in u = tan(θ/4) (times (1 + u²)², of degree ≤ 4).
+
+    `law` is d(θ), by default the sinusoidal law that `derive` proves. Each step is asserted: the
+    rotation part is the rational parametrisation of Rz(θ), the point is on the Study quadric.
+    """
+    cu, su = (1 - u**2) / (1 + u**2), 2 * u / (1 + u**2)
+    Pu = pair_study_point(theta, law)
+    rational = [sp.factor(sp.expand_trig(c.subs(theta, 4 * sp.atan(u))).rewrite(sp.cos)) for c in Pu.as_list()]
+    rational = [sp.factor(sp.simplify(c)) for c in rational]
+    denom = (1 + u**2) ** 2
+    rational = [sp.factor(sp.cancel(c * denom)) for c in rational]
+    x_check = [sp.cancel(c - e) for c, e in zip(rational[:4], [cu * denom, 0, 0, su * denom])]
+    assert all(v == 0 for v in x_check)
+    assert all(sp.Poly(c, u).degree() <= 4 for c in rational if c != 0)
+    assert sp.expand(sum(p * q for p, q in zip(rational[:4], rational[4:]))) == 0
+    return rational
+
+
 def derive():
     """Run the whole A-pair derivation; returns (polynomial sets, kernel specs, facts)."""
     x, y, gens = study_symbols()
@@ -128,21 +150,11 @@ def derive():
     h_expr = sp.sqrt(2 * b_expr)
     half = sp.cos(theta / 2)
     assert sp.simplify(d_sq_sinus - (sp.sqrt(2 * b) * half) ** 2) == 0
-    d_sinus = h * half  # the branch through the highest pose d(0) = +h, continued analytically
-    assert sp.simplify((d_sinus.subs(h, sp.sqrt(2 * b))) ** 2 - d_sq_sinus) == 0
+    d_sinus = SINUSOIDAL_LAW  # h·cos(θ/2): the branch through d(0) = +h, continued analytically
+    assert sp.simplify((d_sinus.subs(h, sp.sqrt(2 * b))) ** 2 - d_sq_sinus) == 0 and d_sinus == h * half
 
     # The rational quartic of the sinusoidal pair in u = tan(θ/4) (homogeneous, one common factor).
-    cu, su = (1 - u**2) / (1 + u**2), 2 * u / (1 + u**2)
-    Pu = pair_study_point(theta, d_sinus)
-    rational = [sp.factor(sp.expand_trig(c.subs(theta, 4 * sp.atan(u))).rewrite(sp.cos)) for c in Pu.as_list()]
-    rational = [sp.factor(sp.simplify(c)) for c in rational]
-    denom = (1 + u**2) ** 2
-    rational = [sp.factor(sp.cancel(c * denom)) for c in rational]
-    x_check = [sp.cancel(c - e) for c, e in zip(rational[:4], [cu * denom, 0, 0, su * denom])]
-    assert all(v == 0 for v in x_check)
-    assert all(sp.Poly(c, u).degree() <= 4 for c in rational if c != 0)
-    assert sp.expand(sum(p * q for p, q in zip(rational[:4], rational[4:]))) == 0
-
+    rational = rational_motion(d_sinus)
     # --- mobility: the six leg lines have rank 5 along the motion ------------------------------
     mobility = mobility_certificate()
 

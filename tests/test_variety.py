@@ -164,3 +164,72 @@ def test_example_variety_in_generated_vanishes_on_its_poses():
     R /= np.linalg.norm(R, axis=1, keepdims=True)
     far = np.abs(np.array([f(*R.T) for f in fns]) / size).max(axis=0)
     assert far.min() > 1e-6
+
+
+# ----------------------------------------------------------------------------- symbolic design
+SYMBOLIC = apair.polynomials.load("chain_variety_symbolic")
+NOTES = {e["label"]: e["note"] for e in apair.polynomials.raw("chain_variety_symbolic")["entries"]}
+DESIGN = sp.symbols("a c_alpha s_alpha h1 h2", real=True)
+
+
+def symbolic_forms(kinds, a, cs, h1, h2, generic_only=False):
+    """The derived forms of a chain kind with a design put in; cs = (cos, sin) of α/2 up to a factor."""
+    vals = dict(zip(DESIGN, (a, *cs, h1, h2)))
+    return [sp.Poly(sp.expand(e.subs(vals)), *X) for label, e in SYMBOLIC.items()
+            if label.startswith(kinds + "_") and not (generic_only and "special" in NOTES[label])]
+
+
+def pair(kind, radius):
+    return apair.APair(radius, radius / 2) if kind == "A" else apair.APair.revolute()
+
+
+def evaluate(forms, S):
+    """|F| / (sum of |coefficients|) of each form at each unit point."""
+    fns = [sp.lambdify(X, F.as_expr(), "numpy") for F in forms]
+    size = np.array([sum(abs(float(c)) for c in F.coeffs()) for F in forms])[:, None]
+    return np.abs(np.array([np.broadcast_to(f(*S.T), len(S)) for f in fns])) / size
+
+
+@pytest.mark.parametrize("kinds", ["AA", "AR", "RA", "RR"])
+def test_symbolic_forms_vanish_on_the_poses_of_random_designs(kinds):
+    """Put random designs into the derived forms: they vanish on 1000 poses from the fk kernel (which
+    knows nothing of them), and the generic ones do not all vanish off the surface."""
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        a, alpha = rng.uniform(0.05, 0.5), rng.uniform(-3.0, 3.0)
+        pairs = [pair(k, r) for k, r in zip(kinds, rng.uniform(0.03, 0.2, 2))]
+        h = [0.0 if p.kind == "revolute" else p.amplitude for p in pairs]
+        chain = apair.AChain(pairs, [a, 0.0], [alpha, 0.0], [0.0, 0.0])
+        cs = (np.cos(alpha / 2), np.sin(alpha / 2))
+        forms = symbolic_forms(kinds, a, cs, *h)
+        assert len(forms) >= 5
+        S = random_poses(chain, 1000, int(rng.integers(1000)))
+        assert evaluate(forms, S / np.linalg.norm(S, axis=1, keepdims=True)).max() < 1e-12
+        R = rng.standard_normal((100, 8))
+        R[:, 4:] -= (np.sum(R[:, :4] * R[:, 4:], 1) / np.sum(R[:, :4] ** 2, 1))[:, None] * R[:, :4]
+        R /= np.linalg.norm(R, axis=1, keepdims=True)
+        assert evaluate(symbolic_forms(kinds, a, cs, *h, generic_only=True), R).max(axis=0).min() > 1e-6
+
+
+def _span(polys, k):
+    mons = V.monomials(k)
+    rows = [[P.coeff_monomial(m) for m in mons] for P in polys if P.total_degree() == k]
+    return sp.Matrix(rows) if rows else sp.zeros(0, len(mons))
+
+
+@pytest.mark.parametrize("kinds", ["AA", "AR", "RR"])
+def test_symbolic_forms_span_what_the_exact_engine_finds(kinds):
+    """At a rational design the specialised forms span exactly the linear forms and quadrics that the
+    engine finds (apair.variety: nullspaces on sampled points), no more and no fewer."""
+    a, t = sp.Rational(2, 5), sp.Rational(3, 7)  # t = tan(α/2)
+    pairs = [pair(k, r) for k, r in zip(kinds, (0.1, 0.05))]  # amplitude sqrt(2 r r/2) = r
+    h = [sp.Rational(1, 10) if kinds[0] == "A" else 0, sp.Rational(1, 20) if kinds[1] == "A" else 0]
+    chain = apair.AChain(pairs, [float(a), 0.0], [2 * np.arctan(3 / 7), 0.0], [0.0, 0.0])
+    W = V.constraint_variety(chain, max_degree=2, hilbert_degree=2)
+    assert W.exact
+    engine, mine = list(W), symbolic_forms(kinds, a, (1, t), *h)
+    for forms in (engine, mine):  # the degree-2 part of the ideal includes x_j · (linear forms)
+        forms += [sp.Poly(g * F.as_expr(), *X) for F in list(forms) if F.total_degree() == 1 for g in X]
+    for k in (1, 2):
+        M, N = _span(engine, k), _span(mine, k)
+        assert M.rank() == W.dims[k] == N.rank() == M.col_join(N).rank()
