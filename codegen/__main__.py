@@ -6,12 +6,13 @@ import sys
 import time
 from pathlib import Path
 
-from derivations import apair_dynamics, apair_pair, chain_dynamics, chain_kinematics, chain_variety
+from derivations import apair_collisions, apair_dynamics, apair_pair, chain_dynamics, chain_kinematics, chain_variety
 
 from .emitter import Emitter, write
 from .varieties import PREFIX as VARIETY_PREFIX
 
 DERIVATIONS = {
+    "apair_collisions": apair_collisions,
     "apair_pair": apair_pair,
     "apair_dynamics": apair_dynamics,
     "chain_kinematics": chain_kinematics,

@@ -6,6 +6,9 @@ kernel for n joints (derivations/chain_kinematics.py); batches stay in the kerne
 """
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 
 from . import _validate as V
@@ -19,9 +22,11 @@ MAX_JOINTS = 6
 
 class AChain:
     """A chain of `pairs` with DH constants a (link lengths), alpha (twists), offset (c),
-    theta_offset (φ). Angles in radians, lengths in metres."""
+    theta_offset (φ). Angles in radians, lengths in metres. `limits`: per joint an explicit range
+    (lo, hi) or None for the pair's own (see `limits`)."""
 
-    def __init__(self, pairs, a, alpha, offset=None, theta_offset=None, links=None, gravity=(0.0, 0.0, -9.81)):
+    def __init__(self, pairs, a, alpha, offset=None, theta_offset=None, links=None, gravity=(0.0, 0.0, -9.81),
+                 limits=None):
         try:
             pairs = list(pairs)
         except TypeError as exc:
@@ -54,6 +59,47 @@ class AChain:
         self._links = np.ascontiguousarray(np.stack([link.as_row() for link in links]))
         self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pairs])
         self._ik = None  # the inverse-kinematics solver, built on the first call of ik()
+        self._explicit_limits = self._check_limits(limits)
+
+    def _check_limits(self, limits):
+        if limits is None:
+            return [None] * self.n
+        try:
+            limits = list(limits)
+        except TypeError as exc:
+            raise ValueError(f"limits: expected one (lo, hi) or None per pair, got {limits!r}") from exc
+        if len(limits) != self.n:
+            raise ValueError(f"limits: expected {self.n} entries (one per pair), got {len(limits)}")
+        out = []
+        for i, lim in enumerate(limits):
+            if lim is None:
+                out.append(None)
+                continue
+            lo, hi = V.vector(f"limits[{i}]", lim, 2)
+            if not lo < hi:
+                raise ValueError(f"limits[{i}]: expected lo < hi, got ({lo}, {hi})")
+            out.append((float(lo), float(hi)))
+        return out
+
+    @property
+    def limits(self) -> np.ndarray:
+        """(n, 2): each joint's range [rad]: the explicit one if given, else the pair's collision
+        limits (`APair.collision_limits`), within its range of motion; a free joint gets one turn
+        (−π, π). An explicit range beyond the collision-free one is refused here."""
+        out = np.empty((self.n, 2))
+        for i, (p, lim) in enumerate(zip(self.pairs, self._explicit_limits)):
+            lo, hi, _ = p.collision_limits()
+            if p.theta_limit is not None:
+                lo, hi = max(lo, -p.theta_limit), min(hi, p.theta_limit)
+            if not (math.isfinite(lo) and math.isfinite(hi)):
+                lo, hi = -math.pi, math.pi
+            if lim is not None:
+                if lim[0] < lo or lim[1] > hi:
+                    raise ValueError(f"limits[{i}]: ({lim[0]:.6g}, {lim[1]:.6g}) goes beyond the pair's "
+                                     f"collision-free range ({lo:.6g}, {hi:.6g})")
+                lo, hi = lim
+            out[i] = lo, hi
+        return out
 
     @property
     def n(self) -> int:
@@ -180,9 +226,10 @@ class AChain:
         return constraint_variety(self, max_degree=max_degree, seed=seed)
 
     # ----------------------------------------------------------------------------- inverse kinematics
-    def ik(self, T, tol: float = 1e-9, full: bool = False):
+    def ik(self, T, tol: float = 1e-9, full: bool = False, within_limits: bool = False):
         """All real joint vectors q (k, n) with fk(q) = T, each verified (largest entry of
         |fk(q) − T| ≤ tol); (0, n) when T is out of reach. T: a 4×4 transform or a Study point.
+        within_limits=True keeps only the solutions inside `limits` (no collisions).
 
         Chains of 1 to 4 sinusoidal A-pairs or R-pairs, by kinematic mapping (see apair.ik): the
         left half's constraint variety on the right part's image, eliminated to eigenvalue and
@@ -195,4 +242,13 @@ class AChain:
         if self._ik is None:
             self._ik = Solver(self)
         sol = self._ik.solve(T, tol=tol, count_complex=full)
+        if within_limits:
+            keep = self.within_limits(sol.q)
+            sol = dataclasses.replace(sol, q=sol.q[keep], error=sol.error[keep])
         return sol if full else sol.q
+
+    def within_limits(self, q) -> np.ndarray:
+        """(...): whether each joint vector lies inside `limits` (bounds included)."""
+        q = self._q(q)
+        lim = self.limits
+        return np.all((q >= lim[:, 0]) & (q <= lim[:, 1]), axis=-1)

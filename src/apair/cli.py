@@ -125,9 +125,27 @@ def _cmd_ik(args) -> int:
             return 1
         print(f"{chain.name}: {len(sol.q)} real solution(s) of {sol.complex_count} complex; "
               f"angles in rad{' and deg' if args.deg else ''}")
-        for q, e in zip(sol.q, sol.error):
+        inside = chain.within_limits(sol.q)
+        for q, e, ok in zip(sol.q, sol.error, inside):
             extra = f"  = {np.degrees(q)} deg" if args.deg else ""
-            print(f"  q = {q}{extra}   |fk(q) - T| = {e:.1e}")
+            print(f"  q = {q}{extra}   |fk(q) - T| = {e:.1e}{'' if ok else '   outside the joint limits'}")
+    return 0
+
+
+def _cmd_limits(args) -> int:
+    chain = load(args.file)
+    lim = chain.limits
+    print(f"{chain.name}: joint ranges [deg] (explicit, or where the legs or plates first touch)")
+    for i, p in enumerate(chain.pairs):
+        what = "explicit" if chain._explicit_limits[i] is not None else p.collision_limits().what
+        print(f"  joint {i}: {np.degrees(lim[i, 0]):+10.4f} .. {np.degrees(lim[i, 1]):+10.4f}   {what}")
+    if args.plot:
+        from .plots import clearance
+
+        k = next((i for i, p in enumerate(chain.pairs) if p.kind != "revolute"), None)
+        if k is None:
+            raise ValueError("file: the chain has no A-pair to plot")
+        print(f"clearance of joint {k} written to {clearance(chain.pairs[k], args.plot, overwrite=args.force)}")
     return 0
 
 
@@ -168,6 +186,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a 4x4 transform row by row (16 numbers, or the top 12) or a Study point (8)")
     p.add_argument("--deg", action="store_true", help="also print the angles in degrees")
     p.set_defaults(func=_cmd_ik)
+    p = sub.add_parser("limits", help="joint ranges of a chain file: explicit, or the pairs' collision limits")
+    p.add_argument("file", help="a chain TOML file")
+    p.add_argument("--plot", metavar="PNG", help="plot the clearance of the first A-pair against theta")
+    p.add_argument("--force", action="store_true", help="replace an existing plot file")
+    p.set_defaults(func=_cmd_limits)
     p = sub.add_parser("kernels", help="list the generated kernels with their operation counts")
     p.set_defaults(func=_cmd_kernels)
     p = sub.add_parser("demo", help="print the derived A-pair law and, given a chain file, one pose")

@@ -6,7 +6,9 @@
     base_radius = 0.05             # A-pairs: triangle circumradii [m]
     platform_radius = 0.05
     leg_length = 0.08              # "general" only: L1 [m]
-    leg_mass = 0.0                 # optional [kg]; leg_radius = 0.0 optional [m]
+    leg_mass = 0.0                 # optional [kg]; leg_radius = 0.0, thickness = 0.0 optional [m]
+    limits = [-1.0, 1.0]           # optional joint range [rad] (or limits_deg); default: the
+                                   # pair's collision limits (a full turn for an R-pair)
     a = 0.3                        # DH link length [m]
     alpha = 1.5707963267948966     # DH twist [rad], or alpha_deg = 90
     offset = 0.0                   # c_i [m] (optional)
@@ -30,11 +32,11 @@ from .link import Link
 from .pair import KINDS, APair
 
 _PAIR_KEYS = {
-    "sinusoidal": {"base_radius", "platform_radius", "leg_mass", "leg_radius"},
-    "general": {"base_radius", "platform_radius", "leg_length", "leg_mass", "leg_radius"},
+    "sinusoidal": {"base_radius", "platform_radius", "leg_mass", "leg_radius", "thickness"},
+    "general": {"base_radius", "platform_radius", "leg_length", "leg_mass", "leg_radius", "thickness"},
     "revolute": set(),
 }
-_DH_KEYS = {"a", "alpha", "alpha_deg", "offset", "theta_offset", "theta_offset_deg"}
+_DH_KEYS = {"a", "alpha", "alpha_deg", "offset", "theta_offset", "theta_offset_deg", "limits", "limits_deg"}
 _LINK_KEYS = {"mass", "com", "inertia"}
 
 
@@ -74,6 +76,16 @@ def _angle(where: str, j: dict, key: str, default=None):
     return default
 
 
+def _limits(where: str, j: dict):
+    """A joint's explicit (lo, hi) in radians, or None."""
+    if "limits" in j and "limits_deg" in j:
+        raise ValueError(f"{where}: give limits or limits_deg, not both")
+    for key, scale in (("limits", 1.0), ("limits_deg", math.pi / 180)):
+        if key in j:
+            return tuple(_numbers(f"{where}.{key}", j[key], [(2,)]) * scale)
+    return None
+
+
 def _number(where: str, v):
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise ValueError(f"{where}: expected a number, got {v!r}")
@@ -88,7 +100,7 @@ def chain_from_dict(data: dict, where: str = "chain") -> AChain:
     joints = data.get("joint")
     if not isinstance(joints, list) or not joints:
         raise ValueError(f"{where}: needs at least one [[joint]] table")
-    pairs, a, alpha, offset, theta_offset, links = [], [], [], [], [], []
+    pairs, a, alpha, offset, theta_offset, links, limits = [], [], [], [], [], [], []
     for i, j in enumerate(joints):
         w = f"{where}: joint[{i}]"
         if not isinstance(j, dict):
@@ -118,9 +130,10 @@ def chain_from_dict(data: dict, where: str = "chain") -> AChain:
         offset.append(_number(f"{w}.offset", j.get("offset", 0.0)))
         theta_offset.append(_angle(w, j, "theta_offset", 0.0))
         links.append(_link(w, j))
+        limits.append(_limits(w, j))
     gravity = _numbers(f"{where}: gravity", data.get("gravity", [0.0, 0.0, -9.81]), [(3,)])
     try:
-        return AChain(pairs, a, alpha, offset, theta_offset, links=links, gravity=gravity)
+        return AChain(pairs, a, alpha, offset, theta_offset, links=links, gravity=gravity, limits=limits)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
 

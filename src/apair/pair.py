@@ -19,14 +19,17 @@ _SINUSOIDAL_RTOL = 1e-12  # |a - b| <= this * b: the leg length is the sinusoida
 class APair:
     """An A-pair with base/platform circumradii r_b, r_p and leg length L1 (None: sinusoidal).
 
-    leg_mass and leg_radius describe the legs (uniform rods; used by dynamics and collisions).
+    leg_mass and leg_radius describe the legs (uniform rods; used by dynamics and collisions), and
+    thickness the plates (slabs about the planes of the leg end points; used by collisions).
     """
 
-    def __init__(self, base_radius, platform_radius, leg_length=None, leg_mass=0.0, leg_radius=0.0):
+    def __init__(self, base_radius, platform_radius, leg_length=None, leg_mass=0.0, leg_radius=0.0, thickness=0.0):
         r_b = V.scalar("base_radius", base_radius, positive=True)
         r_p = V.scalar("platform_radius", platform_radius, positive=True)
         self.leg_mass = V.scalar("leg_mass", leg_mass, nonnegative=True)
         self.leg_radius = V.scalar("leg_radius", leg_radius, nonnegative=True)
+        self.thickness = V.scalar("thickness", thickness, nonnegative=True)
+        self._limits = None
         self.base_radius, self.platform_radius = r_b, r_p
         radii = np.array([r_b, r_p])
         if leg_length is None:
@@ -53,7 +56,8 @@ class APair:
         self = cls.__new__(cls)
         self.kind = "revolute"
         self.base_radius = self.platform_radius = 0.0
-        self.leg_mass = self.leg_radius = 0.0
+        self.leg_mass = self.leg_radius = self.thickness = 0.0
+        self._limits = None
         self._L = None
         self.a = self.b = 0.0
         self._h = 0.0
@@ -85,6 +89,17 @@ class APair:
         if self.kind == "general" and self.a < self.b:
             return math.acos(-self.a / self.b)
         return None
+
+    def collision_limits(self):
+        """(theta_min, theta_max, what touches first): the collision-free range of θ around 0, where
+        the legs (cylinders of radius leg_radius) or the plates (thickness) first touch, found by
+        exact root isolation on the derived contact polynomials (apair.collisions). Infinite for an
+        R-pair. Raises ValueError when the pair cannot move at all."""
+        if self._limits is None:
+            from .collisions import limits
+
+            self._limits = limits(self)
+        return self._limits
 
     def _theta(self, theta, name="theta") -> np.ndarray:
         th = V.real_array(name, theta)

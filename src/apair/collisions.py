@@ -1,0 +1,218 @@
+"""Collision limits of an A-pair: the collision-free range of θ around 0, found by root isolation.
+
+The contact polynomials come from derivations/apair_collisions.py (`apair show apair_collisions`):
+each vanishes where two legs (cylinders of diameter ρ = 2·leg_radius around the leg segments) or
+the two plates (thickness τ) touch, in c = cos(θ/2), s = sin(θ/2), the translation d and q3 = √3.
+For one design they are made univariate, exactly:
+
+1. the design is put in as exact rationals (a float is a binary rational);
+2. d goes: F = A + d·B with d² = a + b cos θ gives A² − d²B²;
+3. c = (1 − t²)/(1 + t²), s = 2t/(1 + t²), t = tan(θ/4), and the powers of 1 + t² (never zero) are
+   cleared;
+4. √3 goes: F = F₀ + √3·F₁ gives F₀² − 3F₁².
+
+Their real roots are isolated by FLINT (certified balls; real roots come out exactly real). Steps 2
+and 4 add roots and a piece only counts inside its segments, so each root is a candidate: it is a
+touch when the true clearance there (segment distances − ρ, plate gap d − τ) is zero. The limits
+are the nearest touches on either side of θ = 0.
+"""
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from functools import lru_cache
+from typing import NamedTuple
+
+import numpy as np
+
+LEG_PAIRS = [(i, j) for i in range(6) for j in range(i + 1, 6)]
+_TOUCH_RTOL = 1e-9  # |clearance| at a touch, relative to the pair's size
+
+
+class CollisionLimits(NamedTuple):
+    """The collision-free interval [theta_min, theta_max] and what touches first ("plates" or
+    "legs i and j"); infinite limits when the pair turns freely."""
+
+    theta_min: float
+    theta_max: float
+    what: str
+
+
+@lru_cache(maxsize=1)
+def _pieces() -> list[tuple[str, list]]:
+    """[(label, [(exponents of c, s, d, q3, r_b, r_p, rho, tau), Fraction])] from the generated set."""
+    import sympy as sp
+
+    from . import polynomials
+
+    out = []
+    for label, expr in polynomials.load("apair_collisions").items():
+        names = {str(x): x for x in expr.free_symbols}
+        gens = [names.get(n, sp.Symbol(n)) for n in ("c", "s", "d", "q3", "r_b", "r_p", "rho", "tau")]
+        terms = [(m, Fraction(int(k.p), int(k.q))) for m, k in sp.Poly(expr, *gens).terms()]
+        out.append((label, terms))
+    return out
+
+
+def _tpoly(coeffs):
+    import flint
+
+    return flint.fmpq_poly([flint.fmpq(f.numerator, f.denominator) for f in coeffs])
+
+
+class _Q3:
+    """Polynomials in t over Q(√3), as a pair (P₀, P₁) meaning P₀ + √3·P₁."""
+
+    def __init__(self, p0, p1=None):
+        import flint
+
+        self.p0, self.p1 = p0, p1 if p1 is not None else flint.fmpq_poly([])
+
+    def __add__(self, o):
+        return _Q3(self.p0 + o.p0, self.p1 + o.p1)
+
+    def __sub__(self, o):
+        return _Q3(self.p0 - o.p0, self.p1 - o.p1)
+
+    def __mul__(self, o):
+        if isinstance(o, _Q3):
+            return _Q3(self.p0 * o.p0 + 3 * self.p1 * o.p1, self.p0 * o.p1 + self.p1 * o.p0)
+        return _Q3(self.p0 * o, self.p1 * o)
+
+    def norm(self):
+        """P₀² − 3P₁²: rational, vanishing wherever P₀ + √3·P₁ does (P₀ itself when P₁ = 0)."""
+        if self.p1 == 0:
+            return self.p0
+        return self.p0 * self.p0 - 3 * self.p1 * self.p1
+
+
+def contact_polynomials(r_b, r_p, a, b, rho, tau) -> list[tuple[str, object]]:
+    """[(label, fmpq_poly in t = tan(θ/4))] whose real roots contain every touch of this design."""
+    import flint
+
+    vals = [Fraction(v) for v in (r_b, r_p, rho, tau)]
+    a, b = Fraction(a), Fraction(b)
+    one_t2 = flint.fmpq_poly([1, 0, 1])
+    cn, sn = flint.fmpq_poly([1, 0, -1]), flint.fmpq_poly([0, 2])
+    d2 = one_t2 * one_t2 * _tpoly([a]) + (cn * cn - sn * sn) * _tpoly([b])  # d² (1 + t²)², k = 2
+    out = []
+    for label, terms in _pieces():
+        # collect A + d·B, each as {power of 1/(1 + t²): Q(√3)[t]}
+        parts = {0: {}, 1: {}}
+        for (i, j, k, l, *p), coef in terms:
+            value = coef * math.prod(v**e for v, e in zip(vals, p))
+            if value == 0:
+                continue
+            if l >= 2:
+                value *= 3 ** (l // 2)
+            num = cn**i * sn**j * d2 ** (k // 2) * _tpoly([value])
+            den = i + j + 2 * (k // 2)
+            term = _Q3(num) if l % 2 == 0 else _Q3(flint.fmpq_poly([]), num)
+            bucket = parts[k % 2]
+            bucket[den] = bucket[den] + term if den in bucket else term
+        A, kA = _combine(parts[0], one_t2)
+        B, kB = _combine(parts[1], one_t2)
+        if B is None:
+            G = A
+        elif A is None:
+            G = B
+        else:  # A/(1+t²)^kA + d B/(1+t²)^kB = 0  ⇒  A² (1+t²)^(2kB+2) − d²(1+t²)² B² (1+t²)^(2kA)
+            lhs = A * A * one_t2 ** (2 * kB + 2)
+            rhs = B * B * d2 * one_t2 ** (2 * kA)
+            G = lhs - rhs
+        poly = G.norm()
+        if poly != 0:
+            out.append((label, poly))
+    return out
+
+
+def _combine(bucket, one_t2):
+    if not bucket:
+        return None, 0
+    K = max(bucket)
+    total = None
+    for k, v in bucket.items():
+        v = v * one_t2 ** (K - k)
+        total = v if total is None else total + v
+    return total, K
+
+
+def real_roots_t(poly) -> list[float]:
+    """The real roots of a rational polynomial, isolated by FLINT and given to double precision."""
+    import flint
+
+    prec, flint.ctx.prec = flint.ctx.prec, 128  # balls far tighter than a double
+    try:
+        found = flint.fmpz_poly(poly.numer()).complex_roots()
+    finally:
+        flint.ctx.prec = prec
+    real = [r if isinstance(r, flint.arb) else r.real for r, _ in found if isinstance(r, flint.arb) or r.imag.is_zero()]
+    return [float(r.mid()) for r in real]
+
+
+def segment_distance(P0, P1, Q0, Q1) -> np.ndarray:
+    """Distance between segments P0P1 and Q0Q1, broadcasting over leading axes (…, 3)."""
+    u, v, w = P1 - P0, Q1 - Q0, P0 - Q0
+    a, b, c = np.sum(u * u, -1), np.sum(u * v, -1), np.sum(v * v, -1)
+    d, e = np.sum(u * w, -1), np.sum(v * w, -1)
+    den = a * c - b * b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.where(den > 1e-14 * a * c, np.clip((b * e - c * d) / den, 0.0, 1.0), 0.0)
+        t = (b * s + e) / c
+        s = np.where(t < 0, np.clip(-d / a, 0.0, 1.0), np.where(t > 1, np.clip((b - d) / a, 0.0, 1.0), s))
+        t = np.clip(t, 0.0, 1.0)
+    gap = w + s[..., None] * u - t[..., None] * v
+    return np.linalg.norm(gap, axis=-1)
+
+
+def clearances(pair, theta) -> tuple[np.ndarray, np.ndarray]:
+    """(…, 15) surface clearance of every leg pair (segment distance − 2·leg_radius) and (…) plate
+    gap d − thickness, at the angles θ."""
+    pts = pair.leg_endpoints(theta)
+    i, j = np.array(LEG_PAIRS).T
+    dist = segment_distance(pts[..., i, 0, :], pts[..., i, 1, :], pts[..., j, 0, :], pts[..., j, 1, :])
+    return dist - 2 * pair.leg_radius, pair.translation(theta) - pair.thickness
+
+
+def limits(pair) -> CollisionLimits:
+    """The collision-free interval around θ = 0 (see the module docstring)."""
+    if pair.kind == "revolute":
+        return CollisionLimits(-math.inf, math.inf, "none")
+    size = pair.base_radius + pair.platform_radius
+    legs0, plate0 = clearances(pair, np.array(0.0))
+    if legs0.min() <= 0:
+        i, j = LEG_PAIRS[int(np.argmin(legs0))]
+        raise ValueError(f"leg_radius: {pair.leg_radius} is too large, legs {i} and {j} overlap at theta = 0 "
+                         f"(the pair cannot move); the largest radius is {(legs0.min() + 2 * pair.leg_radius) / 2:.6g}")
+    if plate0 <= 0:
+        raise ValueError(f"thickness: {pair.thickness} is not less than d(0) = {pair.translation(0.0):.6g}, "
+                         f"the plates overlap at theta = 0 (the pair cannot move)")
+    if pair.kind == "sinusoidal":  # d² = a + b cos θ with a = b = r_b r_p, exactly
+        a = b = Fraction(pair.base_radius) * Fraction(pair.platform_radius)
+    else:  # the design kernel's constants, as the runtime's d(θ) uses them
+        a, b = pair.a, pair.b
+    candidates = set()
+    for _, poly in contact_polynomials(pair.base_radius, pair.platform_radius, a, b, 2 * pair.leg_radius, pair.thickness):
+        candidates.update(4 * math.atan(t) for t in real_roots_t(poly))
+    lim = pair.theta_limit
+    candidates = sorted(th for th in candidates if th != 0 and (lim is None or abs(th) <= lim))
+    upper = _first_touch([th for th in candidates if th > 0], pair, size)
+    lower = _first_touch(sorted((th for th in candidates if th < 0), reverse=True), pair, size)
+    if upper is None and lower is None:
+        return CollisionLimits(-math.inf, math.inf, "none")
+    theta_max, what_max = upper if upper is not None else (math.inf, "none")
+    theta_min, what_min = lower if lower is not None else (-math.inf, "none")
+    return CollisionLimits(theta_min, theta_max, what_max if theta_max <= -theta_min else what_min)
+
+
+def _first_touch(ordered, pair, size):
+    for th in ordered:
+        legs, plate = clearances(pair, np.array(th))
+        k = int(np.argmin(legs))
+        if min(legs[k], plate) < -_TOUCH_RTOL * size:
+            raise RuntimeError(f"collision limits: overlap at theta = {th!r} with no touch before it")
+        if abs(legs[k]) <= _TOUCH_RTOL * size:
+            return th, "legs {} and {}".format(*LEG_PAIRS[k])
+        if abs(plate) <= _TOUCH_RTOL * size:
+            return th, "plates"
+    return None
