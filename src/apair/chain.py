@@ -247,6 +247,17 @@ class AChain:
             sol = dataclasses.replace(sol, q=sol.q[keep], error=sol.error[keep])
         return sol if full else sol.q
 
+    def workspace(self, samples: int = 300_000, resolution: int = 24, rounds: int = 4, poses: bool = False,
+                  engine=None, seed: int = 0, progress=None):
+        """The reachable workspace of the end-effector origin inside `limits` (apair.workspace):
+        `.points`, `.boundary`, `.volume`, `.volume_error` (one standard uncertainty), `.plot(path)`.
+        engine: None (this process), "threads"/"processes" (local Dask) or a dask.distributed
+        scheduler address or Client; the result does not depend on it."""
+        from .workspace import workspace
+
+        return workspace(self, samples=samples, resolution=resolution, rounds=rounds, poses=poses, engine=engine,
+                         seed=seed, progress=progress)
+
     def within_limits(self, q) -> np.ndarray:
         """(...): whether each joint vector lies inside `limits` (bounds included)."""
         q = self._q(q)

@@ -149,6 +149,26 @@ def _cmd_limits(args) -> int:
     return 0
 
 
+def _cmd_workspace(args) -> int:
+    from .workspace import text_progress
+
+    chain = load(args.file)
+    if args.plot:
+        from .plots import _target
+
+        _target(args.plot, args.force)  # refuse before the long run, not after it
+    ws = chain.workspace(samples=args.samples, resolution=args.resolution, engine=args.scheduler,
+                         progress=text_progress() if not args.quiet else None)
+    print(f"{chain.name}: workspace volume {ws.volume:.6g} ± {ws.volume_error:.2g} m^3 (one standard "
+          f"uncertainty) from {len(ws.points)} samples; voxel {ws.voxel:.3g} m, {len(ws.boundary)} boundary voxels")
+    lo, hi = ws.points.min(axis=0), ws.points.max(axis=0)
+    print(f"  bounding box [m]: x {lo[0]:+.4f} .. {hi[0]:+.4f}, y {lo[1]:+.4f} .. {hi[1]:+.4f}, "
+          f"z {lo[2]:+.4f} .. {hi[2]:+.4f}")
+    if args.plot:
+        print(f"  picture written to {ws.plot(args.plot, overwrite=args.force)}")
+    return 0
+
+
 def _cmd_kernels(args) -> int:
     for name, k in sorted(manifest()["kernels"].items()):
         ins = ", ".join(f"{a['name']}{tuple(a['shape'])}" for a in k["inputs"])
@@ -191,6 +211,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", metavar="PNG", help="plot the clearance of the first A-pair against theta")
     p.add_argument("--force", action="store_true", help="replace an existing plot file")
     p.set_defaults(func=_cmd_limits)
+    p = sub.add_parser("workspace", help="reachable workspace of a chain file: volume, boundary, picture")
+    p.add_argument("file", help="a chain TOML file")
+    p.add_argument("--plot", metavar="PNG", help="write a 3D view and cross-sections")
+    p.add_argument("--force", action="store_true", help="replace an existing picture")
+    p.add_argument("--samples", type=int, default=300_000, help="joint samples (default 300000)")
+    p.add_argument("--resolution", type=int, default=24, help="voxels along the longest side (default 24)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run on a dask.distributed scheduler (or 'threads', 'processes')")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_workspace)
     p = sub.add_parser("kernels", help="list the generated kernels with their operation counts")
     p.set_defaults(func=_cmd_kernels)
     p = sub.add_parser("demo", help="print the derived A-pair law and, given a chain file, one pose")
