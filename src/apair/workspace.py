@@ -10,10 +10,13 @@
    surface, so each exposed voxel face takes half a voxel off: V(h) = h³(occupied − ½ faces). What
    remains is of order h (curvature, coverage), so V(h) is measured at five voxel sizes from h₀ to
    2h₀, each with three random grid offsets, and extrapolated linearly to h = 0. The standard
-   uncertainty adds, in quadrature, the fit's standard error, half the extrapolation's length, and
-   twice the change of the estimate between the first half of the samples and all of them
-   (coverage still missing), and the change when every voxel is 1.5 times larger (resolution:
-   edges and thin parts that a linear extrapolation misses).
+   uncertainty adds, in quadrature, the fit's standard error, half the extrapolation's length, the
+   change when every voxel is 1.5 times larger (resolution: edges and thin parts that a linear
+   extrapolation misses), and the coverage still missing.
+4. Coverage: the occupancy after each round grows like V∞ − A·N^(−γ) as sampled regions fill
+   in; fitted to the last three rounds, the remainder A·N^(−γ) is added to the volume and counted,
+   whole, as uncertainty. Where the rounds do not follow that law, twice the change from half the
+   samples to all of them is the uncertainty instead.
 
 The cost is linear in the sample count: the fk kernel (about 1 µs per sample) and one np.unique
 per voxel size and offset (45 of them).
@@ -40,7 +43,7 @@ class Workspace:
     points: (m, 3) end-effector origins of all samples; poses: (m, 8) their Study points (if
     asked for); q: (m, n) the joint samples; boundary: (k, 3) centres of the boundary voxels of
     size `voxel`; volume, volume_error: the extrapolated volume [m³] and one standard uncertainty;
-    history: (samples, occupancy volume at h₀) after each round, the convergence record.
+    history: (samples, corrected occupancy volume at h₀) after each round, the convergence record.
     """
 
     points: np.ndarray
@@ -53,7 +56,7 @@ class Workspace:
     history: list = field(default_factory=list)
     chain_name: str = ""
 
-    def plot(self, path, overwrite: bool = False, chain=None):
+    def plot(self, path, overwrite: bool = False):
         """A 3D view of the points and three cross-sections through the centre (matplotlib)."""
         from .plots import workspace
 
@@ -135,14 +138,12 @@ def _corrected_volume(points, origin, h):
 def _boundary(points, origin, h):
     """Occupied voxels with an empty face neighbour: their integer indices."""
     vox = _voxels(points, origin, h)
-    lo = vox.min(axis=0) - 1
-    dims = vox.max(axis=0) - lo + 2
-    grid = np.zeros(dims, dtype=bool)
-    grid[tuple((vox - lo).T)] = True
+    grid = _grid(vox)
+    inner = vox - (vox.min(axis=0) - 1)
     full = np.ones(len(vox), dtype=bool)
     for axis in range(3):
         for step in (-1, 1):
-            nb = vox - lo
+            nb = inner.copy()
             nb[:, axis] += step
             full &= grid[tuple(nb.T)]
     return vox[~full]
@@ -228,13 +229,43 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
     qs = np.concatenate([p["q"] for p in parts])
     rng = np.random.default_rng((seed, 99))
     volume, fit_err = _estimate(pts, origin, h0, rng)
-    half, _ = _estimate(pts[: len(pts) // 2], origin, h0, np.random.default_rng((seed, 99)))
     coarse, _ = _estimate(pts, origin, COARSER * h0, np.random.default_rng((seed, 99)))
-    error = math.sqrt(fit_err**2 + (COVERAGE_FACTOR * (volume - half)) ** 2 + (volume - coarse) ** 2)
+    missing = _coverage_remainder(history)
+    if missing is None:  # no clean power law in the rounds: the half-sample change, doubled
+        half, _ = _estimate(pts[: len(pts) // 2], origin, h0, np.random.default_rng((seed, 99)))
+        missing = COVERAGE_FACTOR * abs(volume - half)
+    else:
+        volume += missing
+    error = math.sqrt(fit_err**2 + missing**2 + (volume - missing - coarse) ** 2)
     edge = _boundary(pts, origin, h0)
     return Workspace(points=pts, q=qs, boundary=origin + (edge + 0.5) * h0, voxel=h0, volume=volume,
                      volume_error=error, poses=np.concatenate([p["poses"] for p in parts]) if poses else None,
                      history=history, chain_name=getattr(chain, "name", ""))
+
+
+def _coverage_remainder(history) -> float | None:
+    """The volume still to come as the sample count grows without bound, from the occupancy of the
+    last three rounds: V(N) = V∞ − A·N^(−γ) fitted exactly; None when the rounds do not grow
+    like that (fewer than three rounds, no growth, or growth that does not slow down)."""
+    if len(history) < 3:
+        return None
+    (n1, v1), (n2, v2), (n3, v3) = history[-3:]
+    d1, d2 = v2 - v1, v3 - v2
+    if not (d1 > 0 and d2 > 0 and d1 > d2):
+        return None
+
+    def ratio(g):
+        return (n1**-g - n2**-g) / (n2**-g - n3**-g)
+
+    lo, hi = 1e-3, 5.0
+    target = d1 / d2
+    if not ratio(lo) < target < ratio(hi):
+        return None
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ratio(mid) < target else (lo, mid)
+    g = 0.5 * (lo + hi)
+    return float(d2 * n3**-g / (n2**-g - n3**-g))
 
 
 def _member(keys, table):
