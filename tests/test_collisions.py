@@ -51,7 +51,7 @@ def random_pair(rng, kind):
         lo = math.sqrt(max(rb**2 + rp**2 / 4 - rb * rp, 0.0))
         pair = apair.APair(rb, rp, leg_length=lo + rng.uniform(0.01, 1.5) * (rb + rp))
     free = C.clearances(pair, np.array(0.0))[0].min()
-    return apair.APair(rb, rp, None if kind == "sinusoidal" else pair._L[0],
+    return apair.APair(rb, rp, None if kind == "sinusoidal" else pair.leg_lengths[0],
                        leg_radius=rng.uniform(0.0, 0.45) * free, thickness=rng.uniform(0.0, 0.95) * pair.translation(0.0))
 
 

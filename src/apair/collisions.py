@@ -206,8 +206,11 @@ def limits(pair) -> CollisionLimits:
 
 
 def _first_touch(ordered, pair, size):
-    for th in ordered:
-        legs, plate = clearances(pair, np.array(th))
+    """The first candidate (in the given order) where the clearance is zero, and what touches."""
+    if not ordered:
+        return None
+    all_legs, all_plates = clearances(pair, np.array(ordered))
+    for th, legs, plate in zip(ordered, all_legs, all_plates):
         k = int(np.argmin(legs))
         if min(legs[k], plate) < -_TOUCH_RTOL * size:
             raise RuntimeError(f"collision limits: overlap at theta = {th!r} with no touch before it")

@@ -98,24 +98,12 @@ def workspace(ws, path, overwrite: bool = False, max_points: int = 20_000) -> Pa
     return p
 
 
-def _joint(chain, i, th):
-    """A_i(θ) = Rz(θ + φ)·Tz(c + d(θ))·Tx(a)·Rx(α) (CONVENTIONS.md §3), as a 4×4 array."""
-    def rz(t):
-        return np.array([[math.cos(t), -math.sin(t), 0, 0], [math.sin(t), math.cos(t), 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
-
-    def rx(t):
-        return np.array([[1, 0, 0, 0], [0, math.cos(t), -math.sin(t), 0], [0, math.sin(t), math.cos(t), 0], [0, 0, 0, 1]])
-
-    shift = np.eye(4)
-    shift[2, 3] = chain.offset[i] + chain.pairs[i].translation(th)
-    slide = np.eye(4)
-    slide[0, 3] = chain.a[i]
-    return rz(th + chain.theta_offset[i]) @ shift @ slide @ rx(chain.alpha[i])
-
-
 def segments(chain, q) -> list[tuple[np.ndarray, np.ndarray, str]]:
     """The chain at q as line segments (start, end, "link" | "leg" | "plate") in the base frame.
-    A pair is drawn in its base frame (frame i−1 turned by φ_i): legs, base and platform triangles."""
+    A pair is drawn in its base frame (frame i−1 turned by φ_i): legs, base and platform triangles.
+    Frame i is the fk kernel's pose of the chain's first i joints."""
+    from .chain import AChain
+
     q = np.asarray(q, dtype=float)
     T = np.eye(4)
     out = []
@@ -127,7 +115,8 @@ def segments(chain, q) -> list[tuple[np.ndarray, np.ndarray, str]]:
             out += [(leg[0], leg[1], "leg") for leg in legs]
             for tri in (legs[:3, 0], legs[3:, 1]):  # base vertices, platform vertices
                 out += [(tri[k], tri[(k + 1) % 3], "plate") for k in range(3)]
-        T_next = T @ _joint(chain, i, th)
+        k = i + 1
+        T_next = AChain(chain.pairs[:k], chain.a[:k], chain.alpha[:k], chain.offset[:k], chain.theta_offset[:k]).fk(q[:k])
         out.append((T[:3, 3], T_next[:3, 3], "link"))
         T = T_next
     return out

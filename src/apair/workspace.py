@@ -192,21 +192,13 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
     sigma = 0.05 * (hi - lo)
     parts: list[dict] = []
     history = []
-    origin = h0 = None
-    done_batches = [0]
-    total_batches = rounds * math.ceil(per_round / BATCH)
-
-    def tick(k, _n):
-        if progress:
-            progress(done_batches[0] + k, total_batches)
-
+    origin = h0 = pts = qs = None
+    done, total = 0, rounds * math.ceil(per_round / BATCH)
     for r in range(rounds):
         counts = [min(BATCH, per_round - k) for k in range(0, per_round, BATCH)]
         if r == 0:
             tasks = [(chain, lo, hi, (seed, r, k), c, None, None, poses) for k, c in enumerate(counts)]
         else:
-            pts = np.concatenate([p["points"] for p in parts])
-            qs = np.concatenate([p["q"] for p in parts])
             edge = _boundary(pts, origin, h0)
             key = np.floor((pts - origin) / h0).astype(np.int64)
             on_edge = _member(key, edge)
@@ -214,9 +206,11 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
             step = sigma / (1 + r)
             tasks = [(chain, lo, hi, (seed, r, k), c, centres if k % 2 else None, step, poses)
                      for k, c in enumerate(counts)]
+        tick = (lambda k, _n, done=done: progress(done + k, total)) if progress else None
         parts += _run(tasks, engine, tick)
-        done_batches[0] += len(counts)
+        done += len(counts)
         pts = np.concatenate([p["points"] for p in parts])
+        qs = np.concatenate([p["q"] for p in parts])
         if r == 0:
             box_lo, box_hi = pts.min(axis=0), pts.max(axis=0)
             side = float(np.max(box_hi - box_lo))
@@ -225,8 +219,6 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
             h0 = side / resolution
             origin = box_lo - 0.5 * h0
         history.append((len(pts), _corrected_volume(pts, origin, h0)))
-    pts = np.concatenate([p["points"] for p in parts])
-    qs = np.concatenate([p["q"] for p in parts])
     rng = np.random.default_rng((seed, 99))
     volume, fit_err = _estimate(pts, origin, h0, rng)
     coarse, _ = _estimate(pts, origin, COARSER * h0, np.random.default_rng((seed, 99)))
