@@ -56,7 +56,7 @@ test: install lib check
 
 # Timings (never asserted by tests): results in bench/results.json.
 bench: install
-	$(PY) bench/run.py
+	PYTHONPATH=. $(PY) bench/run.py $(BENCH_ARGS)
 
 clean:
 	rm -rf build .venv *.egg-info src/*.egg-info

@@ -1,22 +1,291 @@
-"""`make bench`: timings of the runtime, written to bench/results.json and printed.
+"""`make bench`: the generated kernels against the tools users would pick instead, in one run.
 
-Inverse kinematics (issue 4): the median wall time per pose of `AChain.ik` (every real solution,
-verified), after the per-chain set-up, for the example chains and for random generic 4A designs.
+For chains of n = 2, 4, 6 joints (random DH constants and links; R-pairs, i.e. A-pairs with h = 0,
+so that Pinocchio models exactly the same chain) it times forward kinematics, the Jacobian, the
+mass matrix, inverse and forward dynamics with
+
+- the generated C, batched (one call for many poses) and single-call from Python;
+- the generated NumPy kernels, batched;
+- sympy `lambdify` of the derivation's own expressions (its steps as the common subexpressions),
+  called in a Python loop, one pose per call, as a sympy user would;
+- symengine `Lambdify` of the same expressions (LLVM backend, with CSE), batched and single-call;
+- Pinocchio (`pin`), one call per pose from Python (it has no batched API);
+
+checks that they all agree, and reports per-evaluation medians with min-max over repeats, ratios,
+the operation count of each generated kernel after CSE, growth with n and with the batch size,
+the time of a whole `make generate`, and inverse kinematics of 4A-chains. Results go to
+bench/results.json (or --out). Nothing here is asserted: the targets are reported as met or missed.
 """
 from __future__ import annotations
 
+import argparse
 import json
 import platform
-import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
 import apair
+from apair import kernels
+from apair.generated.numpy import KERNELS as NUMPY_KERNELS
 
 ROOT = Path(__file__).resolve().parent.parent
+OPS = ("fk", "jacobian", "mass_matrix", "inverse_dynamics", "forward_dynamics")
+
+
+# ------------------------------------------------------------------------------------ timing
+def per_item(fn, items: int, repeats: int) -> dict:
+    """Median, min and max over `repeats` runs of fn() (which evaluates `items` items) [ns/item]."""
+    fn()  # warm-up (first-call set-up, caches)
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append((time.perf_counter() - t0) / items * 1e9)
+    return {"median_ns": float(np.median(times)), "min_ns": float(min(times)), "max_ns": float(max(times))}
+
+
+def loop(fn, args_list):
+    """fn(*args) for every args in the list, as a Python loop."""
+    def run():
+        for args in args_list:
+            fn(*args)
+    return run
+
+
+# ------------------------------------------------------------------------------------ chains
+def random_chain(n: int, rng) -> apair.AChain:
+    """Random DH constants and solid-box links; R-pairs, so Pinocchio models the same chain."""
+    links = []
+    for _ in range(n):
+        m = rng.uniform(0.5, 3.0)
+        x, y, z = rng.uniform(0.05, 0.5, 3)
+        principal = m / 12 * np.array([y * y + z * z, x * x + z * z, x * x + y * y])
+        Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        links.append(apair.Link(m, rng.uniform(-0.3, 0.3, 3), Q @ np.diag(principal) @ Q.T))
+    return apair.AChain([apair.APair.revolute() for _ in range(n)], rng.uniform(0.1, 0.5, n),
+                        rng.uniform(-np.pi, np.pi, n), rng.uniform(-0.3, 0.3, n), rng.uniform(-np.pi, np.pi, n),
+                        links=links, gravity=(0.0, 0.0, -9.81))
+
+
+def pin_model(chain: apair.AChain):
+    """The chain as a Pinocchio model (revolute joints about z) with a frame "end" at frame n."""
+    import pinocchio as pin
+
+    model = pin.Model()
+    parent, placement = 0, pin.SE3.Identity()
+    for i in range(chain.n):
+        parent = model.addJoint(parent, pin.JointModelRZ(), placement, f"r{i}")
+        a, alpha, c, phi = chain.a[i], chain.alpha[i], chain.offset[i], chain.theta_offset[i]
+        D = (pin.SE3(pin.utils.rotate("z", phi), np.zeros(3)) * pin.SE3(np.eye(3), np.array([0, 0, c]))
+             * pin.SE3(np.eye(3), np.array([a, 0, 0])) * pin.SE3(pin.utils.rotate("x", alpha), np.zeros(3)))
+        L = chain.links[i]
+        model.appendBodyToJoint(parent, D.act(pin.Inertia(L.mass, L.com, L.inertia)), pin.SE3.Identity())
+        placement = D
+    model.addFrame(pin.Frame("end", parent, 0, placement, pin.FrameType.OP_FRAME))
+    model.gravity = pin.Motion(chain.gravity, np.zeros(3))
+    return model
+
+
+def pin_functions(chain):
+    """Per-pose Pinocchio calls returning the same quantities as the kernels."""
+    import pinocchio as pin
+
+    model = pin_model(chain)
+    data = model.createData()
+    fid = model.getFrameId("end")
+    world = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+    def fk_pose(q):  # for the check; the timing leaves the pose in data (kinder to Pinocchio)
+        pin.framesForwardKinematics(model, data, q)
+        return data.oMf[fid].homogeneous
+
+    timed = {"fk": lambda q: pin.framesForwardKinematics(model, data, q),
+             "jacobian": lambda q: pin.computeFrameJacobian(model, data, q, fid, world),
+             "mass_matrix": lambda q: pin.crba(model, data, q),  # the upper triangle only
+             "inverse_dynamics": lambda q, qd, qdd: pin.rnea(model, data, q, qd, qdd),
+             "forward_dynamics": lambda q, qd, tau: pin.aba(model, data, q, qd, tau)}
+    return timed, dict(timed, fk=fk_pose)
+
+
+# ------------------------------------------------------------------------------------ the same expressions
+def specs(n: int) -> dict:
+    """The derivation's kernel specs for n joints (fk, jacobian; mass matrix, bias, tau)."""
+    from derivations import chain_dynamics, chain_kinematics
+
+    out = {f"fk{n}": chain_kinematics.fk_spec(n), f"jacobian{n}": chain_kinematics.jacobian_spec(n)}
+    out.update({s.name: s for s in chain_dynamics.specs_for(n)})
+    return out
+
+
+def flat_inputs(spec, inputs: list[np.ndarray]) -> np.ndarray:
+    """The kernel inputs as one row of scalars per item, in the spec's symbol order."""
+    batch = np.broadcast_shapes(*(x.shape[: x.ndim - len(a.shape)] for x, a in zip(inputs, spec.inputs)))
+    cols = [np.broadcast_to(x, batch + tuple(a.shape)).reshape(batch + (a.size,)) for x, a in zip(inputs, spec.inputs)]
+    return np.ascontiguousarray(np.concatenate(cols, axis=-1))
+
+
+def sympy_function(spec):
+    """sympy.lambdify of the outputs, with the derivation's steps as the common subexpressions."""
+    import sympy as sp
+
+    args = [s for a in spec.inputs for s in a.symbols]
+    outs = [e for a in spec.outputs for e in a.exprs]
+    return sp.lambdify(args, outs, cse=lambda exprs: (list(spec.steps), exprs))
+
+
+def symengine_function(spec):
+    """symengine.Lambdify (LLVM where available) of the same outputs, the steps substituted in as
+    shared subtrees; returns (function, backend)."""
+    import symengine as se
+
+    env = {}
+
+    def convert(e):
+        x = se.sympify(e)
+        sub = {se.Symbol(str(s)): env[s] for s in e.free_symbols if s in env}
+        return x.subs(sub) if sub else x
+
+    for sym, e in spec.steps:
+        env[sym] = convert(e)
+    import sympy as sp
+
+    outs = [convert(sp.S(e)) for a in spec.outputs for e in a.exprs]
+    args = [se.Symbol(str(s)) for a in spec.inputs for s in a.symbols]
+    try:
+        return se.Lambdify(args, outs, cse=True, backend="llvm"), "llvm"
+    except (RuntimeError, ValueError, TypeError):  # a symengine built without LLVM
+        return se.Lambdify(args, outs, cse=True, backend="lambda"), "lambda"
+
+
+# ------------------------------------------------------------------------------------ one chain
+def bench_chain(n: int, rng, batch: int, single: int, slow: int, repeats: int, pin_ok: bool, se_ok: bool) -> dict:
+    chain = random_chain(n, rng)
+    sp_specs = specs(n)
+    q = rng.uniform(-np.pi, np.pi, (batch, n))
+    qd = rng.normal(size=(batch, n))
+    qdd = rng.normal(size=(batch, n))
+    law = np.zeros((n, 3))
+    design = {"dh": chain._dh, "law": law, "links": chain._links, "legs": chain._legs, "gravity": chain.gravity}
+    per_pose = {"theta": q, "qd": qd, "qdd": qdd}
+    pin_f, pin_check = pin_functions(chain) if pin_ok else ({}, {})
+    out = {}
+    for op in OPS:
+        row = {}
+        if op == "forward_dynamics":  # θ'' = M⁻¹(τ − bias): two kernels and a batched Cholesky solve
+            tau = rng.normal(size=(batch, n))
+            names = [f"mass_matrix{n}", f"bias{n}"]
+            row["kernel"] = " + ".join(names) + " + Cholesky"
+            row["ops"] = sum(kernels.manifest()["kernels"][k]["ops"] for k in names)
+            api = lambda k: (q[k], qd[k], tau[k])
+            row["c_batched"] = per_item(lambda: chain.forward_dynamics(q, qd, tau), batch, repeats)
+            row["c_single_api"] = per_item(loop(chain.forward_dynamics, [api(k) for k in range(single)]), single, repeats)
+            apair.set_backend("numpy")
+            try:
+                row["numpy_batched"] = per_item(lambda: chain.forward_dynamics(q, qd, tau), batch, repeats)
+            finally:
+                apair.set_backend(None)
+            sM, sb = sympy_function(sp_specs[names[0]]), sympy_function(sp_specs[names[1]])
+            fM = flat_inputs(sp_specs[names[0]], [q, chain._dh, law, chain._links, chain._legs])
+            fb = flat_inputs(sp_specs[names[1]], [q, qd, chain._dh, law, chain._links, chain._legs, chain.gravity])
+
+            def sympy_fd(k):
+                return np.linalg.solve(np.reshape(sM(*fM[k]), (n, n)), tau[k] - np.ravel(sb(*fb[k])))
+            row["lambdify_loop"] = per_item(loop(sympy_fd, [(k,) for k in range(slow)]), slow, repeats)
+            reference = chain.forward_dynamics(q[:10], qd[:10], tau[:10])
+            checks = {"lambdify": np.array([sympy_fd(k) for k in range(10)])}
+            if se_ok:
+                (eM, backend), (eb, _) = symengine_function(sp_specs[names[0]]), symengine_function(sp_specs[names[1]])
+                row["symengine_backend"] = backend
+
+                def se_fd_batch():
+                    M = eM(fM).reshape(batch, n, n)
+                    return np.linalg.solve(M, (tau - eb(fb).reshape(batch, n))[..., None])[..., 0]
+                row["symengine_batched"] = per_item(se_fd_batch, batch, repeats)
+                checks["symengine"] = se_fd_batch()[:10]
+            if pin_ok:
+                row["pinocchio_per_call"] = per_item(loop(pin_f[op], [api(k) for k in range(single)]), single, repeats)
+                checks["pinocchio"] = np.array([pin_check[op](*api(k)) for k in range(10)])
+        else:
+            name = f"{op}{n}"
+            spec_j = kernels.manifest()["kernels"][name]
+            row["kernel"] = name
+            row["ops"] = spec_j["ops"]
+            inputs = [per_pose.get(a["name"], design.get(a["name"])) for a in spec_j["inputs"]]
+            one = lambda k: [x[k] if a["name"] in per_pose else x for x, a in zip(inputs, spec_j["inputs"])]
+            row["c_batched"] = per_item(lambda: kernels.call(name, *inputs), batch, repeats)
+            row["c_single"] = per_item(loop(kernels.call, [(name, *one(k)) for k in range(single)]), single, repeats)
+            api_args = {"fk": lambda k: (q[k],), "jacobian": lambda k: (q[k],), "mass_matrix": lambda k: (q[k],),
+                        "inverse_dynamics": lambda k: (q[k], qd[k], qdd[k])}[op]
+            method = getattr(chain, op)
+            row["c_single_api"] = per_item(loop(method, [api_args(k) for k in range(single)]), single, repeats)
+            row["numpy_batched"] = per_item(lambda: NUMPY_KERNELS[name](*inputs), batch, repeats)
+            spec = sp_specs[name]
+            flat = flat_inputs(spec, inputs)
+            sfun = sympy_function(spec)
+            row["lambdify_loop"] = per_item(loop(sfun, [tuple(flat[k]) for k in range(slow)]), slow, repeats)
+            reference = kernels.call(name, *[x[:10] if a["name"] in per_pose else x
+                                             for x, a in zip(inputs, spec_j["inputs"])])[0]
+            checks = {"lambdify": np.array([sfun(*flat[k]) for k in range(10)]),
+                      "numpy": NUMPY_KERNELS[name](*[x[:10] if a["name"] in per_pose else x
+                                                     for x, a in zip(inputs, spec_j["inputs"])])}
+            if se_ok:
+                efun, backend = symengine_function(spec)
+                row["symengine_backend"] = backend
+                row["symengine_batched"] = per_item(lambda: efun(flat), batch, repeats)
+                row["symengine_single"] = per_item(loop(efun, [(flat[k],) for k in range(single)]), single, repeats)
+                checks["symengine"] = efun(flat[:10])
+            if pin_ok:
+                row["pinocchio_per_call"] = per_item(loop(pin_f[op], [api_args(k) for k in range(single)]), single,
+                                                     repeats)
+                got = np.array([pin_check[op](*api_args(k)) for k in range(10)])
+                if op == "mass_matrix":
+                    got = np.triu(got) + np.swapaxes(np.triu(got, 1), -1, -2)
+                checks["pinocchio"] = got
+        ref = np.asarray(reference).reshape(10, -1)
+        row["max_abs_difference"] = {k: float(np.max(np.abs(np.asarray(v, dtype=float).reshape(10, -1) - ref)))
+                                     for k, v in checks.items()}
+        c = row["c_batched"]["median_ns"]
+        ratios = {}
+        for peer in ("numpy_batched", "lambdify_loop", "symengine_batched", "pinocchio_per_call"):
+            if peer in row:
+                ratios[peer] = row[peer]["median_ns"] / c
+        row["peer_over_c_batched"] = ratios
+        if "c_single" in row:  # best of the repeats for both: the overhead itself, without the machine's noise
+            row["single_call_overhead_ns"] = row["c_single"]["min_ns"] - row["c_batched"]["min_ns"]
+        out[op] = row
+    return out
+
+
+def batch_scaling(n: int, rng, repeats: int) -> dict:
+    """ns per item of the C kernels against the batch size (one call per batch)."""
+    chain = random_chain(n, rng)
+    out = {}
+    for op in ("fk", "inverse_dynamics"):
+        name = f"{op}{n}"
+        rows = {}
+        for size in (1, 10, 100, 1000, 10_000, 100_000):
+            q = rng.uniform(-np.pi, np.pi, (size, n))
+            args = {"theta": q, "qd": q, "qdd": q, "dh": chain._dh, "law": np.zeros((n, 3)), "links": chain._links,
+                    "legs": chain._legs, "gravity": chain.gravity}
+            inputs = [args[a["name"]] for a in kernels.manifest()["kernels"][name]["inputs"]]
+            calls = max(1, 20_000 // size)
+            rows[size] = per_item(loop(kernels.call, [(name, *inputs)] * calls), size * calls, repeats)
+        out[name] = rows
+    return out
+
+
+def time_generate() -> float:
+    """Seconds for the whole derivation and code generation (`make generate`), into a scratch folder."""
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "codegen", "--out", tmp], cwd=ROOT, check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        return time.perf_counter() - t0
 
 
 def random_4a(rng) -> apair.AChain:
@@ -26,6 +295,7 @@ def random_4a(rng) -> apair.AChain:
 
 
 def time_ik(chains, poses_per_chain: int, rng) -> dict:
+    """Median wall time per pose of AChain.ik (every real solution, verified), after set-up."""
     times, setup, solutions = [], [], []
     for chain in chains:
         Ts = chain.fk(rng.uniform(-np.pi, np.pi, (poses_per_chain, chain.n)))
@@ -38,30 +308,107 @@ def time_ik(chains, poses_per_chain: int, rng) -> dict:
             times.append(time.perf_counter() - t0)
             solutions.append(len(q))
     ms = np.array(times) * 1e3
-    return {"poses": len(times), "median_ms": float(np.median(ms)), "p10_ms": float(np.percentile(ms, 10)),
-            "p90_ms": float(np.percentile(ms, 90)), "max_ms": float(ms.max()),
-            "first_call_ms": float(statistics.median(setup) * 1e3),
-            "solutions_per_pose": float(np.mean(solutions))}
+    return {"poses": len(times), "median_ms": float(np.median(ms)), "min_ms": float(ms.min()),
+            "max_ms": float(ms.max()), "p90_ms": float(np.percentile(ms, 90)),
+            "first_call_ms": float(np.median(setup) * 1e3), "solutions_per_pose": float(np.mean(solutions))}
 
 
-def main() -> int:
+# ------------------------------------------------------------------------------------ report
+def fmt(ns: float) -> str:
+    return f"{ns / 1e6:.3g} ms" if ns >= 1e6 else f"{ns / 1e3:.3g} µs" if ns >= 1e3 else f"{ns:.3g} ns"
+
+
+def targets(results: dict) -> list[dict]:
+    """The issue's targets, each met or missed with the measured numbers."""
+    out = []
+    six = results["kernels"].get("6", {})
+    for op in ("fk", "jacobian", "mass_matrix", "inverse_dynamics"):
+        row = six.get(op, {})
+        if "pinocchio_per_call" in row:
+            r = row["peer_over_c_batched"]["pinocchio_per_call"]
+            out.append({"target": f"batched C >= 2x faster than Pinocchio per call, {op}, n = 6", "measured": r,
+                        "met": r >= 2.0})
+    worst = max(row["single_call_overhead_ns"] for rows in results["kernels"].values() for row in rows.values()
+                if "single_call_overhead_ns" in row)
+    out.append({"target": "single-call Python overhead (apair.kernels.call, best of repeats) < 2 µs, worst kernel",
+                "measured": worst / 1e3, "met": worst < 2000})
+    worst_np = min(row["peer_over_c_batched"]["lambdify_loop"] / row["peer_over_c_batched"]["numpy_batched"]
+                   for rows in results["kernels"].values() for row in rows.values())
+    out.append({"target": "batched NumPy >= 10x faster than a Python loop over lambdify, worst case",
+                "measured": worst_np, "met": worst_np >= 10})
+    if results.get("make_generate_s") is not None:
+        g = results["make_generate_s"]
+        out.append({"target": "make generate < 120 s", "measured": g, "met": g < 120})
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="bench/run.py", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="small batches and few repeats (a smoke run)")
+    ap.add_argument("--no-generate", action="store_true", help="skip timing make generate")
+    ap.add_argument("--out", type=Path, default=ROOT / "bench" / "results.json")
+    args = ap.parse_args(argv)
+    try:
+        import pinocchio  # noqa: F401
+        pin_ok = True
+    except ImportError:
+        pin_ok = False
+    try:
+        import symengine  # noqa: F401
+        se_ok = True
+    except ImportError:
+        se_ok = False
     rng = np.random.default_rng(0)
+    batch, single, slow, repeats = (1000, 200, 20, 3) if args.quick else (10_000, 2000, 200, 7)
     results = {"machine": {"python": sys.version.split()[0], "platform": platform.platform(),
-                           "numpy": np.__version__, "backend": apair.backend()}, "ik": {}}
-    cases = {
-        "4A random generic designs (10 x 50 poses)": ([random_4a(rng) for _ in range(10)], 50),
-        "examples/4a_chain.toml (parallel axes)": ([apair.load(ROOT / "examples/4a_chain.toml")], 200),
-        "examples/2a_chain.toml": ([apair.load(ROOT / "examples/2a_chain.toml")], 200),
-    }
-    print("inverse kinematics, time per pose (all real solutions, each verified by fk):")
-    for name, (chains, k) in cases.items():
-        r = time_ik(chains, k, rng)
-        results["ik"][name] = r
-        print(f"  {name:45s} median {r['median_ms']:6.2f} ms  (p10 {r['p10_ms']:.2f}, p90 {r['p90_ms']:.2f}, "
-              f"first call {r['first_call_ms']:.1f} ms, {r['solutions_per_pose']:.2f} solutions/pose)")
-    out = ROOT / "bench" / "results.json"
-    out.write_text(json.dumps(results, indent=1) + "\n")
-    print(f"written to {out.relative_to(ROOT)}")
+                           "processor": platform.processor() or platform.machine(), "numpy": np.__version__,
+                           "apair_backend": apair.backend(), "pinocchio": pin_ok, "symengine": se_ok},
+               "settings": {"batch": batch, "single_calls": single, "lambdify_calls": slow, "repeats": repeats},
+               "kernels": {}}
+    if not (pin_ok and se_ok):
+        print("note: install the bench extra (pip install .[bench]) for Pinocchio and symengine", file=sys.stderr)
+    for n in (2, 4, 6):
+        print(f"n = {n}: deriving the expressions for lambdify/symengine and timing ...", file=sys.stderr, flush=True)
+        results["kernels"][str(n)] = bench_chain(n, rng, batch, single, slow, repeats, pin_ok, se_ok)
+    results["batch_scaling"] = batch_scaling(6, rng, repeats)
+    cases = {"4A random generic designs": ([random_4a(rng) for _ in range(3 if args.quick else 10)], 10 if args.quick else 50),
+             "examples/4a_chain.toml": ([apair.load(ROOT / "examples/4a_chain.toml")], 20 if args.quick else 200)}
+    results["ik"] = {name: time_ik(chains, k, rng) for name, (chains, k) in cases.items()}
+    results["make_generate_s"] = None if args.no_generate else time_generate()
+    results["targets"] = targets(results)
+
+    print("\nper evaluation, median over repeats (ratio = peer time / batched C time):")
+    cols = [("c_batched", "C batched"), ("c_single", "C 1 call"), ("c_single_api", "API 1 call"),
+            ("numpy_batched", "NumPy batch"), ("lambdify_loop", "lambdify loop"), ("symengine_batched", "symengine"),
+            ("pinocchio_per_call", "Pinocchio")]
+    print(f"{'kernel':24s}{'ops':>7s}" + "".join(f"{c[1]:>15s}" for c in cols))
+    for n, rows in results["kernels"].items():
+        for op, row in rows.items():
+            cells = []
+            for key, _ in cols:
+                if key not in row:
+                    cells.append(f"{'-':>15s}")
+                    continue
+                r = row["peer_over_c_batched"].get(key)
+                cells.append(f"{fmt(row[key]['median_ns']) + (f' ({r:.0f}x)' if r and r >= 10 else f' ({r:.1f}x)' if r else ''):>15s}")
+            print(f"{op + ' n=' + n:24s}{row['ops']:>7d}" + "".join(cells))
+    print("\nbatch scaling (C, ns per item):")
+    for name, rows in results["batch_scaling"].items():
+        print(f"  {name:20s}" + "  ".join(f"{size}: {fmt(r['median_ns'])}" for size, r in rows.items()))
+    print("\ninverse kinematics per pose (all real solutions, verified):")
+    for name, r in results["ik"].items():
+        print(f"  {name:30s} median {r['median_ms']:.2f} ms (min {r['min_ms']:.2f}, max {r['max_ms']:.2f}; "
+              f"{r['solutions_per_pose']:.1f} solutions)")
+    if results["make_generate_s"] is not None:
+        print(f"\nmake generate (derivations + code generation): {results['make_generate_s']:.1f} s")
+    worst = max(v for rows in results["kernels"].values() for row in rows.values()
+                for v in row["max_abs_difference"].values())
+    print(f"largest difference between the tools' results: {worst:.2e}")
+    print("\ntargets:")
+    for t in results["targets"]:
+        print(f"  [{'met' if t['met'] else 'MISSED'}] {t['target']}: {t['measured']:.3g}")
+    args.out.write_text(json.dumps(results, indent=1) + "\n")
+    print(f"written to {args.out}")
     return 0
 
 

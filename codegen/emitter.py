@@ -1,10 +1,11 @@
 """The one emitter: lower kernel specs with CSE, render them with jinja2, write generated/.
 
 `lower` turns a KernelSpec into straight-line code (assignments after common-subexpression
-elimination); `Emitter.render` hands the lowered kernels of each derivation to the templates in
-codegen/templates and returns {relative path: text}. Output is deterministic: the same specs give
-byte-identical files, each naming the derivation that produced it and a content hash of its inputs
-(the kernel specs and the template).
+elimination), printed for C and NumPy; `Emitter.render` hands the lowered kernels of each
+derivation to the templates in codegen/templates and returns {relative path: text}. Lowering is
+the expensive part and is independent per kernel, so codegen/__main__.py runs it in parallel.
+Output is deterministic: the same specs give byte-identical files, each naming the derivation that
+produced it and a content hash of its inputs (the kernel specs and the template).
 """
 from __future__ import annotations
 
@@ -26,18 +27,90 @@ PREFIX = "apair_"
 
 
 @dataclass
-class Lowered:
-    """A kernel as straight-line code, ready for the templates."""
+class Signature:
+    """What the templates need of a kernel spec: names, shapes and docs, without expressions."""
 
-    spec: KernelSpec
+    name: str
+    doc: str
+    source: str
+    inputs: list[Arg]
+    outputs: list[Arg]
+
+
+@dataclass
+class Code:
+    """Straight-line code printed for one target: (name, expression) assignments, then outputs."""
+
+    assignments: list[tuple[str, str]]
+    outputs: list[tuple[Arg, list[str]]]
+
+
+@dataclass
+class Hoisted:
+    """The C form of a kernel with its design-only part split off: `invariants` (assignments that
+    depend on design inputs alone) fill inv[0..len(stored)), from which `core` evaluates one item.
+    A batch whose design inputs all have stride 0 computes the invariants once."""
+
+    inv_inputs: list[tuple[Arg, list[tuple[int, str]]]]
+    invariants: list[tuple[str, str]]
+    stored: list[str]
+    core_inputs: list[tuple[Arg, list[tuple[int, str]]]]
+    core: list[tuple[str, str]]
+
+
+@dataclass
+class Lowered:
+    """A kernel as printed straight-line code, ready for the templates (cheap to pickle)."""
+
+    spec: Signature
     inputs: list[tuple[Arg, list[tuple[int, str]]]]  # each input with the (slot, name) it reads
-    assignments: list[tuple[str, sp.Expr]]
-    outputs: list[tuple[Arg, list[sp.Expr]]]
+    c: Code
+    py: Code
     ops: int
+    fingerprint: str
+    hoisted: Hoisted | None  # None: nothing depends on design inputs alone
 
     @property
     def name(self) -> str:
         return self.spec.name
+
+
+PRINTERS = {"c": CPrinter(), "py": NumpyPrinter()}
+
+
+def _bare(a: Arg) -> Arg:
+    return Arg(a.name, tuple(a.shape), a.doc, design=a.design)
+
+
+def _slots(spec_inputs, local, used) -> list[tuple[Arg, list[tuple[int, str]]]]:
+    """Each input with the (slot, name) pairs of its symbols in `used`."""
+    out = []
+    for a in spec_inputs:
+        syms = [local.get(s, s) for s in a.symbols]
+        out.append((_bare(a), [(k, str(s)) for k, s in enumerate(syms) if s in used]))
+    return out
+
+
+def _hoist(spec: KernelSpec, local: dict, assignments, reduced, printed: dict) -> Hoisted | None:
+    """Split the assignments into those that depend on design inputs alone and the rest
+    (`printed`: the C text of each assignment)."""
+    design = {local.get(s, s) for a in spec.inputs if a.design for s in a.symbols}
+    if not design:
+        return None
+    invariant = set()
+    for sym, e in assignments:
+        if e.free_symbols <= design | invariant:
+            invariant.add(sym)
+    inv = [(sym, e) for sym, e in assignments if sym in invariant]
+    core = [(sym, e) for sym, e in assignments if sym not in invariant]
+    needed = set().union(*(e.free_symbols for _, e in core), *(sp.S(e).free_symbols for e in reduced))
+    stored = [sym for sym, _ in inv if sym in needed]
+    if not stored:
+        return None
+    used_inv = set().union(*(e.free_symbols for _, e in inv))
+    return Hoisted(_slots(spec.inputs, local, used_inv), [(str(s), printed[s]) for s, _ in inv],
+                   [str(s) for s in stored], _slots(spec.inputs, local, needed),
+                   [(str(s), printed[s]) for s, _ in core])
 
 
 def lower(spec: KernelSpec) -> Lowered:
@@ -74,16 +147,20 @@ def lower(spec: KernelSpec) -> Lowered:
         used |= e.free_symbols
     for e in reduced:
         used |= sp.S(e).free_symbols
-    inputs = []
-    for a in spec.inputs:
-        syms = [local.get(s, s) for s in a.symbols]
-        inputs.append((a, [(k, str(s)) for k, s in enumerate(syms) if s in used]))
+    inputs = _slots(spec.inputs, local, used)
     outs, pos = [], 0
     for a in spec.outputs:
         outs.append((a, list(reduced[pos:pos + a.size])))
         pos += a.size
     ops = int(sp.count_ops([e for _, e in assignments] + list(reduced)))
-    return Lowered(spec, inputs, [(str(s), e) for s, e in assignments], outs, ops)
+    printed = {target: {s: p.doprint(e) for s, e in assignments} for target, p in PRINTERS.items()}
+    code = {target: Code([(str(s), printed[target][s]) for s, _ in assignments],
+                         [(_bare(a), [p.doprint(e) for e in es]) for a, es in outs])
+            for target, p in PRINTERS.items()}
+    signature = Signature(spec.name, spec.doc, spec.source, [_bare(a) for a in spec.inputs],
+                          [_bare(a) for a in spec.outputs])
+    return Lowered(signature, inputs, code["c"], code["py"], ops, spec.fingerprint(),
+                   _hoist(spec, local, assignments, reduced, printed["c"]))
 
 
 def _ordered(replacements, steps):
@@ -125,21 +202,19 @@ class Emitter:
             lstrip_blocks=True,
             undefined=jinja2.StrictUndefined,
         )
-        self.c = CPrinter()
-        self.np = NumpyPrinter()
-        self.env.filters["c"] = self.c.doprint
-        self.env.filters["py"] = self.np.doprint
         self.env.filters["shape"] = _shape_doc
+        self.env.filters["dims"] = lambda a: ", ".join(str(d) for d in (tuple(a.shape) + (0, 0, 0))[:3])
 
     def _template(self, name: str) -> tuple[jinja2.Template, str]:
         return self.env.get_template(name), (TEMPLATES / name).read_text()
 
-    def render(self, groups: dict[str, list[KernelSpec]], poly_sets: list[PolynomialSet]) -> dict[str, str]:
-        """groups: {derivation module stem: its kernel specs} -> {path under generated/: text}."""
-        files: dict[str, str] = {}
-        lowered = {stem: [lower(s) for s in specs] for stem, specs in groups.items() if specs}  # skip set-only ones
+    def render(self, lowered: dict[str, list[Lowered]], poly_files: dict[str, str]) -> dict[str, str]:
+        """lowered: {derivation module stem: its lowered kernels}; poly_files: the rendered
+        polynomial sets (`render_polynomials`) -> {path under generated/: text}."""
+        files: dict[str, str] = dict(poly_files)
+        lowered = {stem: ks for stem, ks in lowered.items() if ks}  # skip set-only derivations
         all_kernels = [k for ks in lowered.values() for k in ks]
-        fingerprints = {k.name: k.spec.fingerprint() for k in all_kernels}
+        fingerprints = {k.name: k.fingerprint for k in all_kernels}
 
         header_t, header_src = self._template("apair.h.j2")
         src_t, src_src = self._template("kernels.c.j2")
@@ -147,6 +222,10 @@ class Emitter:
         header_hash = content_hash([header_src] + [fingerprints[k.name] for k in all_kernels])
         sources = sorted({k.spec.source for k in all_kernels})
         files["c/apair.h"] = header_t.render(kernels=all_kernels, hash=header_hash, sources=sources, prefix=PREFIX)
+        registry_t, registry_src = self._template("registry.c.j2")
+        files["c/apair_registry.c"] = registry_t.render(
+            kernels=sorted(all_kernels, key=lambda k: k.name), prefix=PREFIX, sources=sources,
+            hash=content_hash([registry_src] + [fingerprints[k.name] for k in all_kernels]))
         manifest = {"content_hash": header_hash, "prefix": PREFIX, "kernels": {}}
         for stem, ks in lowered.items():
             source = ks[0].spec.source
@@ -170,9 +249,15 @@ class Emitter:
         files["manifest.json"] = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
         files["__init__.py"] = (f'"""Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.\n\n'
                                 f'Content hash: {header_hash}\n"""\n')
-        for ps in poly_sets:
-            files.update(render_polynomial_set(ps, content_hash))
         return files
+
+
+def render_polynomials(poly_sets: list[PolynomialSet]) -> dict[str, str]:
+    """The text, LaTeX and JSON files of polynomial sets."""
+    files: dict[str, str] = {}
+    for ps in poly_sets:
+        files.update(render_polynomial_set(ps, content_hash))
+    return files
 
 
 def content_hash(parts: list[str]) -> str:

@@ -70,10 +70,11 @@ def dynamics_inputs(n: int):
         "dh": dh,
         "law": law,
         "links": Arg("links", (n, 10), "per link (mass [kg], com [m] in frame i (3), inertia about the com in "
-                     "frame i: Ixx, Iyy, Izz, Ixy, Ixz, Iyz [kg m^2])", tuple(j[k] for j in J for k in LINK_FIELDS)),
+                     "frame i: Ixx, Iyy, Izz, Ixy, Ixz, Iyz [kg m^2])", tuple(j[k] for j in J for k in LINK_FIELDS),
+                     design=True),
         "legs": Arg("legs", (n, 3), "per pair (leg mass [kg], r_b [m], r_p [m]); zeros for an R-pair",
-                    tuple(j[k] for j in J for k in LEG_FIELDS)),
-        "gravity": Arg("gravity", (3,), "gravity vector in the base frame [m/s^2]", gvec),
+                    tuple(j[k] for j in J for k in LEG_FIELDS), design=True),
+        "gravity": Arg("gravity", (3,), "gravity vector in the base frame [m/s^2]", gvec, design=True),
     }
     return args, J, sp.Matrix(gvec)
 
@@ -386,9 +387,17 @@ def specs_for(n: int) -> list[KernelSpec]:
     ]
 
 
-def derive():
-    checks = {n: check_bias(n) for n in (1, 2, 3)}
-    specs = []
-    for n in range(1, MAX_N + 1):
-        specs += specs_for(n)
-    return [], specs, {"bias_check": checks}
+PARTS = ("check",) + tuple(range(1, MAX_N + 1))  # codegen runs these as parallel jobs
+
+
+def derive(part=None):
+    """(sets, specs, facts) of one part, or of all: "check" proves the RNEA bias and gravity equal
+    to the Lagrangian ones for n = 1..3; a number n gives the kernels of the n-joint chain."""
+    if part is None:
+        parts = [derive(p) for p in PARTS]
+        return [], [s for _, specs, _ in parts for s in specs], parts[0][2]
+    if part == "check":
+        return [], [], {"bias_check": {n: check_bias(n) for n in (1, 2, 3)}}
+    if part not in PARTS:
+        raise ValueError(f"part: expected one of {PARTS}, got {part!r}")
+    return [], specs_for(part), {}

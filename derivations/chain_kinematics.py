@@ -37,7 +37,7 @@ def chain_inputs(n: int, law_width: int = 3) -> tuple[list[Arg], list[dict]]:
     return [
         Arg("theta", (n,), "joint angles theta_i [rad]", tuple(j["theta"] for j in J)),
         Arg("dh", (n, 4), "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])",
-            tuple(j[k] for j in J for k in ("a", "alpha", "c", "phi"))),
+            tuple(j[k] for j in J for k in ("a", "alpha", "c", "phi")), design=True),
         Arg("law", (n, law_width), "per joint (d_i [m], d'_i [m/rad], d''_i [m/rad^2]) from a law kernel",
             tuple(j[k] for j in J for k in ("d", "dd", "ddd")[:law_width])),
     ], J

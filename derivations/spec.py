@@ -15,13 +15,16 @@ import sympy as sp
 
 @dataclass(frozen=True)
 class Arg:
-    """A named array argument: `symbols` fill it in row-major (C) order."""
+    """A named array argument: `symbols` fill it in row-major (C) order. A `design` input is a
+    constant of the mechanism (DH parameters, inertias, gravity), usually shared by a whole batch:
+    the C batch functions compute what depends on design inputs alone once per shared design."""
 
     name: str
     shape: tuple[int, ...]
     doc: str
     symbols: tuple[sp.Symbol, ...] = ()
     exprs: tuple[sp.Expr, ...] = ()
+    design: bool = False
 
     @property
     def size(self) -> int:
@@ -75,7 +78,7 @@ class KernelSpec:
         h = hashlib.sha256()
         h.update(self.name.encode())
         for a in self.inputs:
-            h.update(f"in {a.name} {a.shape} {[str(s) for s in a.symbols]}".encode())
+            h.update(f"in {a.name} {a.shape} {[str(s) for s in a.symbols]}{' design' if a.design else ''}".encode())
         for sym, expr in self.steps:
             h.update(f"step {sym} {sp.srepr(expr)}".encode())
         for a in self.outputs:

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: ba0d3c61deb5abbd
+Content hash: bb17d567f9e11922
 """

@@ -1,6 +1,8 @@
 """Shared fixtures: the symbolic kernel specs (re-derived once per session) and their evaluation."""
 from __future__ import annotations
 
+import importlib
+
 import mpmath
 import numpy as np
 import pytest
@@ -13,7 +15,7 @@ from codegen.__main__ import DERIVATIONS
 @pytest.fixture(scope="session")
 def derivations():
     """{module name: (polynomial sets, kernel specs, facts)}, derived afresh once per session."""
-    return {name: mod.derive() for name, mod in DERIVATIONS.items()}
+    return {name: importlib.import_module(f"derivations.{name}").derive() for name in DERIVATIONS}
 
 
 @pytest.fixture(scope="session")

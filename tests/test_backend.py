@@ -12,13 +12,19 @@ from apair import kernels
 
 def test_c_is_the_default_when_installed(monkeypatch):
     monkeypatch.delenv("APAIR_BACKEND", raising=False)
+    apair.set_backend(None)
     assert apair.c_available()
     assert apair.backend() == "c"
 
 
 def test_environment_selects_numpy(monkeypatch):
     monkeypatch.setenv("APAIR_BACKEND", "numpy")
-    assert apair.backend() == "numpy"
+    apair.set_backend(None)  # the environment is read again
+    try:
+        assert apair.backend() == "numpy"
+    finally:
+        monkeypatch.delenv("APAIR_BACKEND")
+        apair.set_backend(None)
 
 
 def test_missing_library_falls_back_once(monkeypatch):
@@ -27,8 +33,9 @@ def test_missing_library_falls_back_once(monkeypatch):
         [apair.APair(0.05, 0.04), apair.APair.revolute()], [0.3, 0.2], [np.pi / 2, 0.0])
     q = np.array([0.2, -0.4])
     with_c = chain.fk(q)
-    monkeypatch.setattr(kernels, "_library", lambda: (None, "the compiled C library is gone (test)"))
+    monkeypatch.setattr(kernels, "_native", lambda: (None, "the compiled C kernels are gone (test)"))
     monkeypatch.setitem(kernels._state, "warned", False)
+    monkeypatch.setitem(kernels._state, "resolved", None)
     with pytest.warns(RuntimeWarning, match="using the NumPy kernels"):
         first = chain.fk(q)
     with warnings.catch_warnings():

@@ -20,7 +20,7 @@ def real_array(name: str, value, *, trailing: tuple[int, ...] | None = None, ndi
             raise ValueError(f"{name}: expected shape {want}, got {arr.shape}")
     if ndim_max is not None and arr.ndim > ndim_max:
         raise ValueError(f"{name}: expected at most {ndim_max} dimensions, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
+    if not np.isfinite(arr).all():
         raise ValueError(f"{name}: contains NaN or infinite values")
     return arr
 

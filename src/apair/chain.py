@@ -58,6 +58,8 @@ class AChain:
         self.gravity = V.vector("gravity", gravity, 3)
         self._links = np.ascontiguousarray(np.stack([link.as_row() for link in links]))
         self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pairs])
+        self._law_groups = self._group_laws()
+        self._ranged = [i for i, p in enumerate(pairs) if p.theta_limit is not None]  # angles to check
         self._ik = None  # the inverse-kinematics solver, built on the first call of ik()
         self._explicit_limits = self._check_limits(limits)
 
@@ -114,14 +116,34 @@ class AChain:
         q = V.real_array(name, q, trailing=(self.n,))
         return q
 
+    def _group_laws(self):
+        """One law-kernel call per kind of pair: (kernel, joint indices, its parameters (k, 1))."""
+        groups = []
+        for kind, kernel, params in (("sinusoidal", "law_sinusoidal", lambda p: (p._h,)),
+                                     ("general", "law_general", lambda p: (p.a, p.b))):
+            idx = [i for i, p in enumerate(self.pairs) if p.kind == kind]
+            if idx:
+                values = np.array([params(self.pairs[i]) for i in idx])
+                groups.append((kernel, np.array(idx), [np.ascontiguousarray(values[:, [k]])
+                                                       for k in range(values.shape[1])]))
+        return groups
+
     def law(self, q) -> np.ndarray:
         """(..., n, 3): each joint's (d, d', d'') at q."""
-        q = self._q(q)
-        return np.stack([p.law(q[..., i], name=f"q[..., {i}]") for i, p in enumerate(self.pairs)], axis=-2)
+        return self._law(self._q(q))
+
+    def _law(self, q: np.ndarray) -> np.ndarray:
+        """law() of a validated q; each pair with a restricted range checks its angles."""
+        for i in self._ranged:
+            self.pairs[i]._theta(q[..., i], name=f"q[..., {i}]")
+        out = np.zeros(q.shape + (3,))
+        for kernel, idx, params in self._law_groups:
+            out[..., idx, :] = call(kernel, q[..., idx, None], *params)[0]
+        return out
 
     def _kernel(self, stem: str, q, law=None):
         q = self._q(q)
-        return call(f"{stem}{self.n}", q, self._dh, self.law(q) if law is None else law)[0]
+        return call(f"{stem}{self.n}", q, self._dh, self._law(q) if law is None else law)[0]
 
     def fk(self, q) -> np.ndarray:
         """(..., 4, 4): the pose of frame n in the base frame; q is (n,) or (..., n)."""
@@ -134,7 +156,7 @@ class AChain:
     def jacobian(self, q) -> np.ndarray:
         """(..., 6, n): geometric Jacobian, base frame, rows [v; ω] (v of the origin of frame n)."""
         law = self.law(q)
-        if np.any(~np.isfinite(law)):
+        if self._ranged and not np.isfinite(law).all():
             raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
         return self._kernel("jacobian", q, law)
 
@@ -149,9 +171,9 @@ class AChain:
         except ValueError:
             first = next(iter(named))
             raise ValueError(f"{first}: batch shape does not match q: {[x.shape for x in arrays]}") from None
-        arrays = [np.broadcast_to(x, shape) for x in arrays]
-        law = self.law(arrays[0])
-        if np.any(~np.isfinite(law)):
+        arrays = [x if x.shape == shape else np.broadcast_to(x, shape) for x in arrays]
+        law = self._law(arrays[0])
+        if self._ranged and not np.isfinite(law).all():
             raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
         return arrays, law
 

@@ -1,26 +1,25 @@
-"""The generated kernels, behind one call interface, from C (ctypes) or from NumPy.
+"""The generated kernels, behind one call interface, from C (apair._native) or from NumPy.
 
 `call(name, *inputs)` evaluates kernel `name` over leading batch axes of its inputs and returns
-its outputs. The C library (`apair._libapair`, built from generated/c at install time) is the
-default; the generated NumPy kernels are used on request (`set_backend("numpy")` or the
-environment variable APAIR_BACKEND=numpy) or when the library is missing, which is said once.
-Kernel signatures come from generated/manifest.json, so nothing here is written per kernel.
+its outputs. The C kernels, through the extension module `apair._native` (built from generated/c
+at install time), are the default; the generated NumPy kernels are used on request
+(`set_backend("numpy")` or the environment variable APAIR_BACKEND=numpy) or when the extension is
+missing, which is said once. Kernel signatures come from generated/manifest.json and the C
+registry, so nothing here is written per kernel.
 """
 from __future__ import annotations
 
-import ctypes
-import importlib.machinery
+import importlib
 import json
 import os
 import warnings
 from functools import lru_cache
 from importlib import resources
-from pathlib import Path
 
 import numpy as np
 
 _BACKENDS = ("c", "numpy")
-_state = {"backend": None, "warned": False}
+_state = {"backend": None, "warned": False, "resolved": None}
 
 
 @lru_cache(maxsize=None)
@@ -29,70 +28,70 @@ def manifest() -> dict:
     return json.loads(resources.files("apair.generated").joinpath("manifest.json").read_text())
 
 
-def _library_path() -> Path | None:
-    pkg = Path(__file__).parent
-    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
-        path = pkg / f"_libapair{suffix}"
-        if path.exists():
-            return path
-    return None
-
-
 @lru_cache(maxsize=None)
-def _library():
-    """The ctypes handle of the compiled kernels, or None (with the reason)."""
-    path = _library_path()
-    if path is None:
-        return None, "the compiled C library apair._libapair is not installed"
+def _native():
+    """The extension module with the compiled kernels, or None (with the reason)."""
     try:
-        return ctypes.CDLL(str(path)), None
-    except OSError as exc:  # pragma: no cover - depends on the platform
-        return None, f"the C library {path} could not be loaded: {exc}"
+        module = importlib.import_module("apair._native")
+    except ImportError as exc:
+        return None, f"the compiled C kernels (apair._native) are not installed ({exc})"
+    if module.content_hash != manifest()["content_hash"]:
+        return None, (f"the compiled C kernels (apair._native, {module.content_hash}) were built from other "
+                      f"generated code than the manifest ({manifest()['content_hash']}): reinstall apair")
+    return module, None
 
 
 def c_available() -> bool:
-    return _library()[0] is not None
+    return _native()[0] is not None
 
 
 def set_backend(name: str | None) -> None:
-    """Choose "c" or "numpy" for every later kernel call (None: the default, C when present)."""
+    """Choose "c" or "numpy" for every later kernel call (None: the default, which reads
+    APAIR_BACKEND again and otherwise takes C when present)."""
     if name is not None and name not in _BACKENDS:
         raise ValueError(f"backend: expected one of {_BACKENDS} or None, got {name!r}")
     if name == "c" and not c_available():
-        raise ValueError(f"backend: 'c' requested but {_library()[1]}")
+        raise ValueError(f"backend: 'c' requested but {_native()[1]}")
     _state["backend"] = name
+    _state["resolved"] = None
 
 
 def backend() -> str:
-    """The backend in use: the explicit choice, else APAIR_BACKEND, else C when it is installed."""
+    """The backend in use: the explicit choice, else APAIR_BACKEND (read on the first kernel call
+    and after set_backend(None)), else C when it is installed."""
+    resolved = _state["resolved"]
+    if resolved is None:
+        resolved = _state["resolved"] = _resolve_backend()
+    return resolved
+
+
+def _resolve_backend() -> str:
     choice = _state["backend"] or os.environ.get("APAIR_BACKEND") or None
     if choice is not None:
         if choice not in _BACKENDS:
             raise ValueError(f"APAIR_BACKEND: expected one of {_BACKENDS}, got {choice!r}")
         if choice == "c" and not c_available():
-            raise ValueError(f"APAIR_BACKEND: 'c' requested but {_library()[1]}")
+            raise ValueError(f"APAIR_BACKEND: 'c' requested but {_native()[1]}")
         return choice
     if c_available():
         return "c"
     if not _state["warned"]:
-        warnings.warn(f"apair: {_library()[1]}; using the NumPy kernels", RuntimeWarning, stacklevel=3)
+        warnings.warn(f"apair: {_native()[1]}; using the NumPy kernels", RuntimeWarning, stacklevel=4)
         _state["warned"] = True
     return "numpy"
 
 
-@lru_cache(maxsize=None)
-def _c_functions(name: str):
-    lib = _library()[0]
-    spec = manifest()["kernels"][name]
-    prefix = manifest()["prefix"]
-    n_in, n_out = len(spec["inputs"]), len(spec["outputs"])
-    single = getattr(lib, prefix + name)
-    single.argtypes = [ctypes.c_void_p] * (n_in + n_out)
-    single.restype = None
-    batch = getattr(lib, prefix + name + "_batch")
-    batch.argtypes = [ctypes.c_size_t] + [ctypes.c_void_p, ctypes.c_ssize_t] * n_in + [ctypes.c_void_p] * n_out
-    batch.restype = None
-    return single, batch
+_c_indices: dict[str, int] = {}
+
+
+def _c_index(native, name: str) -> int:
+    """The registry index of kernel `name` in the extension module."""
+    if not _c_indices:
+        _c_indices.update((n, i) for i, n in enumerate(native.names()))
+    try:
+        return _c_indices[name]
+    except KeyError:
+        raise ValueError(f"kernel: no generated kernel called {name!r}") from None
 
 
 @lru_cache(maxsize=None)
@@ -102,37 +101,32 @@ def _numpy_function(name: str):
     return KERNELS[name]
 
 
-def _call_c(name: str, inputs: list[np.ndarray]):
-    spec = manifest()["kernels"][name]
-    shapes = [tuple(a["shape"]) for a in spec["inputs"]]
-    batch = np.broadcast_shapes(*(x.shape[: x.ndim - len(s)] for x, s in zip(inputs, shapes)))
-    outs = [np.empty(batch + tuple(a["shape"])) for a in spec["outputs"]]
-    single, batched = _c_functions(name)
-    if batch == ():
-        args = [np.ascontiguousarray(x) for x in inputs]
-        single(*[x.ctypes.data for x in args], *[o.ctypes.data for o in outs])
-        return outs
-    count = int(np.prod(batch))
-    argv = [ctypes.c_size_t(count)]
-    keep = []
-    for x, s in zip(inputs, shapes):
-        size = int(np.prod(s))
-        if x.ndim == len(s):  # one value for the whole batch
-            x = np.ascontiguousarray(x)
-            stride = 0
-        else:
-            x = np.ascontiguousarray(np.broadcast_to(x, batch + s)).reshape(count, size)
-            stride = size
-        keep.append(x)
-        argv += [x.ctypes.data, stride]
-    batched(*argv, *[o.ctypes.data for o in outs])
-    return outs
+def _canonical(name: str, inputs) -> list[np.ndarray]:
+    """The inputs as float64 C-contiguous arrays with one common batch shape (or none)."""
+    spec = manifest()["kernels"][name]["inputs"]
+    if len(inputs) != len(spec):
+        raise TypeError(f"{name}: expected {len(spec)} inputs, got {len(inputs)}")
+    arrays = [np.asarray(x, dtype=np.float64) for x in inputs]
+    shapes = [tuple(a["shape"]) for a in spec]
+    for x, s, a in zip(arrays, shapes, spec):
+        if x.ndim < len(s) or x.shape[x.ndim - len(s):] != s:
+            raise ValueError(f"{name}: input {a['name']} must end in shape {s}, got {x.shape}")
+    batch = np.broadcast_shapes(*(x.shape[: x.ndim - len(s)] for x, s in zip(arrays, shapes)))
+    return [np.ascontiguousarray(x if x.ndim == len(s) else np.broadcast_to(x, batch + s))
+            for x, s in zip(arrays, shapes)]
 
 
 def call(name: str, *inputs) -> list[np.ndarray]:
     """Evaluate kernel `name`; inputs are float64 arrays with the kernel's trailing shapes."""
+    if (_state["resolved"] or backend()) == "c":
+        native = _native()[0]
+        index = _c_indices.get(name)
+        if index is None:
+            index = _c_index(native, name)
+        out = native.call(index, *inputs)
+        if out is None:  # some input needs converting or broadcasting first
+            out = native.call(index, *_canonical(name, inputs))
+        return out
     inputs = [np.asarray(x, dtype=np.float64) for x in inputs]
-    if backend() == "c":
-        return _call_c(name, inputs)
     out = _numpy_function(name)(*inputs)
     return list(out) if isinstance(out, tuple) else [out]
