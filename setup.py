@@ -18,6 +18,7 @@ setup(
         Extension(
             "apair._native",
             sources=sorted(glob("generated/c/*.c")) + ["src/apair/_native.c"],
+            depends=sorted(glob("generated/c/*.h")),  # rebuild when the header (and its hash) changes
             include_dirs=["generated/c", numpy.get_include()],
             extra_compile_args=["-std=c11", "-O2", "-fno-math-errno"],
             libraries=["m"],

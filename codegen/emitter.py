@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,6 +25,8 @@ from .polynomials import render_polynomial_set
 
 TEMPLATES = Path(__file__).parent / "templates"
 PREFIX = "apair_"
+# The package version, stamped into the C library (header, CMake, pkg-config).
+VERSION = tomllib.loads((Path(__file__).resolve().parent.parent / "pyproject.toml").read_text())["project"]["version"]
 
 
 @dataclass
@@ -219,13 +222,19 @@ class Emitter:
         header_t, header_src = self._template("apair.h.j2")
         src_t, src_src = self._template("kernels.c.j2")
         py_t, py_src = self._template("kernels.py.j2")
-        header_hash = content_hash([header_src] + [fingerprints[k.name] for k in all_kernels])
+        header_hash = content_hash([header_src, VERSION] + [fingerprints[k.name] for k in all_kernels])
         sources = sorted({k.spec.source for k in all_kernels})
-        files["c/apair.h"] = header_t.render(kernels=all_kernels, hash=header_hash, sources=sources, prefix=PREFIX)
+        files["c/apair.h"] = header_t.render(kernels=all_kernels, hash=header_hash, sources=sources, prefix=PREFIX,
+                                             version=VERSION)
         registry_t, registry_src = self._template("registry.c.j2")
         files["c/apair_registry.c"] = registry_t.render(
             kernels=sorted(all_kernels, key=lambda k: k.name), prefix=PREFIX, sources=sources,
             hash=content_hash([registry_src] + [fingerprints[k.name] for k in all_kernels]))
+        c_sources = sorted(["apair_registry.c"] + [f"{stem}.c" for stem in lowered])
+        for name in ("CMakeLists.txt", "apair.pc.in"):
+            t, src = self._template(f"{name}.j2")
+            files[f"c/{name}"] = t.render(sources=sources, c_sources=c_sources, version=VERSION,
+                                          hash=content_hash([src, VERSION] + c_sources))
         manifest = {"content_hash": header_hash, "prefix": PREFIX, "kernels": {}}
         for stem, ks in lowered.items():
             source = ks[0].spec.source

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: bb17d567f9e11922
+Content hash: d088880e31b4c953
 """

@@ -1,13 +1,20 @@
-"""Layer 5: the generated C builds cleanly (C99 strict, and as C++) and runs clean under ASan/UBSan.
+"""Layer 5: the generated C is a standalone library: it builds cleanly with gcc and clang, at -O0
+and -O3, as C99 and as C++17, runs clean under ASan/UBSan, and builds with a plain cc command
+line, with CMake (add_subdirectory, or installed and found by find_package) and with pkg-config.
 
-The driver is written from generated/manifest.json: it calls every kernel, single and batched
-(with a shared, stride-0 input), and checks the batch against the single calls.
+The driver is written from generated/manifest.json: it calls every kernel, single, batched (with a
+shared, stride-0 input) and through the registry, and checks them against each other. The example
+program (examples/c/chain_4a.c) is checked number by number against the Python runtime.
 """
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
+import sys
+import tomllib
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -17,6 +24,7 @@ CDIR = ROOT / "generated" / "c"
 MANIFEST = json.loads((ROOT / "generated" / "manifest.json").read_text())
 STRICT = ["-Wall", "-Wextra", "-Werror", "-pedantic"]
 SOURCES = sorted(str(p) for p in CDIR.glob("*.c"))
+MANIFEST_VERSION = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is required")
 
@@ -51,7 +59,7 @@ def driver_source() -> str:
             lines.append(f"        for (i = 0; i < {total}; ++i) in{j}[i] = val(i + {31 * j});")
         for j, a in enumerate(k["outputs"]):
             n = size(a["shape"])
-            lines.append(f"        double out{j}[{n * count}], one{j}[{n}];")
+            lines.append(f"        double out{j}[{n * count}], one{j}[{n}], batch{j}[{n * count}];")
             lines.append(f"        for (i = 0; i < {n * count}; ++i) out{j}[i] = NAN;")
         ins = lambda off: ", ".join(f"in{j} + {off if j == 0 else 0} * {size(a['shape'])}" for j, a in enumerate(k["inputs"]))
         strided = ", ".join(f"in{j}, {size(a['shape']) if j == 0 else 0}" for j, a in enumerate(k["inputs"]))
@@ -68,8 +76,38 @@ def driver_source() -> str:
             lines.append("                }")
             lines.append("            }")
         lines.append("        }")
+        # the registry entry gives the same numbers through its uniform entry points
+        n_in, n_out = len(k["inputs"]), len(k["outputs"])
+        lines.append("        {")
+        lines.append(f'            const {prefix}kernel *r = {prefix}find_kernel("{name}");')
+        lines.append(f"            const double *rin[{n_in}];")
+        lines.append(f"            double *rout[{n_out}];")
+        lines.append(f"            ptrdiff_t rstride[{n_in}];")
+        for j, a in enumerate(k["inputs"]):
+            lines.append(f"            rin[{j}] = in{j};")
+            lines.append(f"            rstride[{j}] = {size(a['shape']) if j == 0 else 0};")
+        lines.append(f"            if (r == NULL || r->n_inputs != {n_in} || r->n_outputs != {n_out}) {{")
+        lines.append(f'                printf("{name}: registry entry\\n"); ++failures;')
+        lines.append("            } else {")
+        for j, a in enumerate(k["outputs"]):
+            lines.append(f"                if (r->outputs[{j}].size != {size(a['shape'])}) {{ printf(\"{name}: size\\n\"); ++failures; }}")
+            lines.append(f"                rout[{j}] = one{j};")
+        lines.append("                r->eval(rin, rout);")
+        for j, a in enumerate(k["outputs"]):
+            n = size(a["shape"])
+            lines.append(f"                for (i = 0; i < {n}; ++i) if (one{j}[i] != out{j}[i]) {{ printf(\"{name}: eval\\n\"); ++failures; break; }}")
+        for j, a in enumerate(k["outputs"]):
+            lines.append(f"                rout[{j}] = batch{j};")
+        lines.append(f"                r->eval_batch({count}, rin, rstride, rout);")
+        for j, a in enumerate(k["outputs"]):
+            n = size(a["shape"]) * count
+            lines.append(f"                for (i = 0; i < {n}; ++i) if (batch{j}[i] != out{j}[i]) {{ printf(\"{name}: eval_batch\\n\"); ++failures; break; }}")
+        lines.append("            }")
+        lines.append("        }")
         lines.append("    }")
-    lines += ['    if (failures == 0) printf("ok\\n");', "    return failures != 0;", "}", ""]
+    lines += ['    if ({prefix}find_kernel("no_such_kernel") != NULL) {{ printf("registry: unknown name found\\n"); ++failures; }}'
+              .format(prefix=prefix),
+              '    if (failures == 0) printf("ok\\n");', "    return failures != 0;", "}", ""]
     return "\n".join(lines)
 
 
@@ -87,18 +125,151 @@ def test_strict_c99_compiles():
         run(["gcc", "-std=c99", *STRICT, "-O0", "-c", src, "-o", "/dev/null"])
 
 
-def test_header_and_sources_compile_as_cxx(driver, tmp_path):
-    exe = tmp_path / "driver_cxx"
-    run(["g++", "-x", "c++", "-std=c++17", *STRICT, "-O0", f"-I{CDIR}", *SOURCES, str(driver), "-o", str(exe)])
-    assert run([str(exe)]).stdout.strip() == "ok"
+# (compiler, language, optimisation, sanitizers): gcc and clang, -O0 and -O3, C99 and C++17, and
+# AddressSanitizer + UndefinedBehaviorSanitizer, each at least once. Never -ffast-math (apair.h).
+CONFIGS = [
+    ("gcc", "c99", "-O0", True),
+    ("gcc", "c99", "-O3", False),
+    ("g++", "c++17", "-O0", False),
+    ("clang", "c99", "-O0", True),
+    ("clang", "c99", "-O3", False),
+    ("clang++", "c++17", "-O3", False),
+]
+SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer"]
+SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=1", "UBSAN_OPTIONS": "halt_on_error=1"}
+EXAMPLE = ROOT / "examples" / "c" / "chain_4a.c"
 
 
-def test_kernels_clean_under_sanitizers(driver, tmp_path):
-    exe = tmp_path / "driver_san"
-    flags = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer", "-O0"]
-    run(["gcc", "-std=c99", *STRICT, *flags, f"-I{CDIR}", *SOURCES, str(driver), "-o", str(exe), "-lm"])
-    res = run([str(exe)], env={"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=1", "UBSAN_OPTIONS": "halt_on_error=1"})
-    assert res.stdout.strip() == "ok" and res.stderr == ""
+def tool(name: str) -> str | None:
+    """A build tool from the environment's own bin folder (the test extra installs cmake and
+    pkgconf there), else from PATH."""
+    local = Path(sys.executable).parent / name
+    return str(local) if local.exists() else shutil.which(name)
+
+
+def build(compiler, lang, opt, sanitize, programs, out: Path) -> dict[str, Path]:
+    """Compile the library sources and each program (in parallel, one object per source) and link
+    one executable per program; returns {program stem: executable}."""
+    flags = ["-std=" + lang, *STRICT, opt, f"-I{CDIR}"] + (SANITIZE if sanitize else [])
+    lang_flag = ["-x", "c++"] if lang.startswith("c++") else []
+    out.mkdir(parents=True, exist_ok=True)
+    sources = [Path(s) for s in SOURCES] + [Path(p) for p in programs]
+    objects = {src: out / f"{src.stem}.o" for src in sources}
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        list(pool.map(lambda src: run([compiler, *lang_flag, *flags, "-c", str(src), "-o", str(objects[src])]),
+                      sources))
+    lib = [str(objects[Path(s)]) for s in SOURCES]
+    exes = {}
+    for p in map(Path, programs):
+        exe = out / p.stem
+        run([compiler, *flags, str(objects[p]), *lib, "-o", str(exe), "-lm"])
+        exes[p.stem] = exe
+    return exes
+
+
+def sanitizers_link(compiler: str, tmp: Path) -> bool:
+    """Whether the compiler can link a program with ASan and UBSan (their runtimes are separate
+    packages for clang on some distributions)."""
+    src = tmp / "probe.c"
+    src.write_text("int main(void) { return 0; }\n")
+    res = subprocess.run([compiler, *SANITIZE, str(src), "-o", str(tmp / "probe")], capture_output=True)
+    return res.returncode == 0
+
+
+def python_state(rng):
+    """The example chain and a random state: (chain, q, qd, qdd)."""
+    import numpy as np
+
+    import apair
+
+    chain = apair.load(ROOT / "examples" / "4a_chain.toml")
+    return chain, rng.uniform(-1, 1, 4), rng.uniform(-1, 1, 4), rng.uniform(-1, 1, 4)
+
+
+def check_example(exe, env=None) -> None:
+    """Run the example program at a random state and compare every number with the runtime."""
+    import numpy as np
+
+    chain, q, qd, qdd = python_state(np.random.default_rng(7))
+    res = run([str(exe), *(repr(float(x)) for x in (*q, *qd, *qdd))], env=env)
+    lines = res.stdout.splitlines()
+    assert lines[0].startswith("apair ") and MANIFEST["content_hash"] in lines[0]
+    got = {line.split()[0]: np.array([float(x) for x in line.split()[1:]]) for line in lines[1:]}
+    np.testing.assert_allclose(got["T"].reshape(4, 4), chain.fk(q), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(got["J"].reshape(6, 4), chain.jacobian(q), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(got["tau"], chain.inverse_dynamics(q, qd, qdd), rtol=1e-12, atol=1e-12)
+    if env is not None:
+        assert res.stderr == ""
+
+
+@pytest.mark.parametrize("compiler, lang, opt, sanitize", CONFIGS, ids=lambda v: str(v))
+def test_library_driver_and_example_across_compilers(compiler, lang, opt, sanitize, driver, tmp_path):
+    """Every kernel single, batched and through the registry (the driver), and the example
+    program against the Python runtime, for one compiler configuration."""
+    if shutil.which(compiler) is None:
+        pytest.skip(f"{compiler} is not installed (Debian/Ubuntu: apt install clang)")
+    if sanitize and not sanitizers_link(compiler, tmp_path):
+        pytest.skip(f"{compiler} has no sanitizer runtime here (Debian/Ubuntu: apt install libclang-rt-dev)")
+    exes = build(compiler, lang, opt, sanitize, [driver, EXAMPLE], tmp_path)
+    env = SAN_ENV if sanitize else None
+    res = run([str(exes["driver"])], env=env)
+    assert res.stdout.strip() == "ok"
+    if sanitize:
+        assert res.stderr == ""
+    check_example(exes["chain_4a"], env=env)
+
+
+def test_plain_cc_command_line_builds_the_example(tmp_path):
+    """The README's one-line build: no Python, no build system."""
+    exe = tmp_path / "chain_4a"
+    run(["cc", "-std=c99", f"-I{CDIR}", str(EXAMPLE), *SOURCES, "-o", str(exe), "-lm"])
+    check_example(exe)
+
+
+@pytest.fixture(scope="module")
+def cmake():
+    path = tool("cmake")
+    if path is None:
+        pytest.fail("cmake is missing: it is in the test extra (pip install .[test])")
+    return path
+
+
+def test_cmake_add_subdirectory_builds_the_example(cmake, tmp_path):
+    build_dir = tmp_path / "build"
+    run([cmake, "-S", str(ROOT / "examples" / "c"), "-B", str(build_dir)])
+    run([cmake, "--build", str(build_dir), "--parallel", "2"])
+    check_example(build_dir / "chain_4a")
+
+
+def test_cmake_install_serves_find_package_and_pkg_config(cmake, tmp_path):
+    """Install the library, then build the example against it with find_package(apair) and with
+    the flags pkg-config gives."""
+    prefix = tmp_path / "prefix"
+    run([cmake, "-S", str(CDIR), "-B", str(tmp_path / "lib"), f"-DCMAKE_INSTALL_PREFIX={prefix}"])
+    run([cmake, "--build", str(tmp_path / "lib"), "--parallel", "2"])
+    run([cmake, "--install", str(tmp_path / "lib")])
+    assert (prefix / "include" / "apair.h").exists()
+    consumer = tmp_path / "consumer"
+    consumer.mkdir()
+    (consumer / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.13)\nproject(consumer LANGUAGES C)\n"
+        f"find_package(apair {MANIFEST_VERSION} CONFIG REQUIRED)\n"
+        f"add_executable(chain_4a {EXAMPLE.as_posix()})\ntarget_link_libraries(chain_4a PRIVATE apair::apair)\n")
+    run([cmake, "-S", str(consumer), "-B", str(consumer / "build"), f"-DCMAKE_PREFIX_PATH={prefix}"])
+    run([cmake, "--build", str(consumer / "build")])
+    check_example(consumer / "build" / "chain_4a")
+
+    pkg_config = tool("pkg-config") or tool("pkgconf")
+    if pkg_config is None:
+        pytest.fail("pkg-config is missing: pkgconf is in the test extra (pip install .[test])")
+    pc_dirs = [str(p.parent) for p in prefix.rglob("apair.pc")]
+    assert pc_dirs, "no apair.pc installed"
+    env = dict(os.environ, PKG_CONFIG_PATH=os.pathsep.join(pc_dirs))
+    flags = run([pkg_config, "--cflags", "--libs", "apair"], env=env).stdout.split()
+    assert run([pkg_config, "--modversion", "apair"], env=env).stdout.strip() == MANIFEST_VERSION
+    exe = tmp_path / "chain_4a_pc"
+    run(["cc", "-std=c99", str(EXAMPLE), *flags, "-o", str(exe)])
+    check_example(exe)
 
 
 def test_driver_detects_a_broken_kernel(driver, tmp_path):
@@ -113,3 +284,15 @@ def test_driver_detects_a_broken_kernel(driver, tmp_path):
     run(["gcc", "-std=c99", "-O0", f"-I{CDIR}", str(broken), *others, str(driver), "-o", str(exe), "-lm"])
     res = subprocess.run([str(exe)], capture_output=True, text=True)
     assert res.returncode != 0 and "item 0" in res.stdout
+
+
+def test_no_allocation_io_or_mutable_state_in_the_library():
+    """Real-time use: no allocation, no I/O and no writable file-scope state in any source."""
+    import re
+
+    for path in [CDIR / "apair.h", *map(Path, SOURCES)]:
+        text = path.read_text()
+        assert not re.search(r"\b(malloc|calloc|realloc|free|alloca|printf|fopen|exit|abort)\s*\(", text), path
+        for line in text.splitlines():
+            if line.startswith(("static ", "extern ")) or re.match(r"^(double|int|float|char|size_t)\b.*[=;]\s*$", line):
+                assert line.startswith(("static void", "static const", "extern const", "extern \"C\"")), (path, line)
