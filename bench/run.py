@@ -169,83 +169,50 @@ def bench_chain(n: int, rng, batch: int, single: int, slow: int, repeats: int, p
     q = rng.uniform(-np.pi, np.pi, (batch, n))
     qd = rng.normal(size=(batch, n))
     qdd = rng.normal(size=(batch, n))
+    tau = rng.normal(size=(batch, n))
     law = np.zeros((n, 3))
     design = {"dh": chain._dh, "law": law, "links": chain._links, "legs": chain._legs, "gravity": chain.gravity}
-    per_pose = {"theta": q, "qd": qd, "qdd": qdd}
+    per_pose = {"theta": q, "qd": qd, "qdd": qdd, "tau": tau}
     pin_f, pin_check = pin_functions(chain) if pin_ok else ({}, {})
     out = {}
     for op in OPS:
         row = {}
-        if op == "forward_dynamics":  # θ'' = M⁻¹(τ − bias): two kernels and a batched Cholesky solve
-            tau = rng.normal(size=(batch, n))
-            names = [f"mass_matrix{n}", f"bias{n}"]
-            row["kernel"] = " + ".join(names) + " + Cholesky"
-            row["ops"] = sum(kernels.manifest()["kernels"][k]["ops"] for k in names)
-            api = lambda k: (q[k], qd[k], tau[k])
-            row["c_batched"] = per_item(lambda: chain.forward_dynamics(q, qd, tau), batch, repeats)
-            row["c_single_api"] = per_item(loop(chain.forward_dynamics, [api(k) for k in range(single)]), single, repeats)
-            apair.set_backend("numpy")
-            try:
-                row["numpy_batched"] = per_item(lambda: chain.forward_dynamics(q, qd, tau), batch, repeats)
-            finally:
-                apair.set_backend(None)
-            sM, sb = sympy_function(sp_specs[names[0]]), sympy_function(sp_specs[names[1]])
-            fM = flat_inputs(sp_specs[names[0]], [q, chain._dh, law, chain._links, chain._legs])
-            fb = flat_inputs(sp_specs[names[1]], [q, qd, chain._dh, law, chain._links, chain._legs, chain.gravity])
-
-            def sympy_fd(k):
-                return np.linalg.solve(np.reshape(sM(*fM[k]), (n, n)), tau[k] - np.ravel(sb(*fb[k])))
-            row["lambdify_loop"] = per_item(loop(sympy_fd, [(k,) for k in range(slow)]), slow, repeats)
-            reference = chain.forward_dynamics(q[:10], qd[:10], tau[:10])
-            checks = {"lambdify": np.array([sympy_fd(k) for k in range(10)])}
-            if se_ok:
-                (eM, backend), (eb, _) = symengine_function(sp_specs[names[0]]), symengine_function(sp_specs[names[1]])
-                row["symengine_backend"] = backend
-
-                def se_fd_batch():
-                    M = eM(fM).reshape(batch, n, n)
-                    return np.linalg.solve(M, (tau - eb(fb).reshape(batch, n))[..., None])[..., 0]
-                row["symengine_batched"] = per_item(se_fd_batch, batch, repeats)
-                checks["symengine"] = se_fd_batch()[:10]
-            if pin_ok:
-                row["pinocchio_per_call"] = per_item(loop(pin_f[op], [api(k) for k in range(single)]), single, repeats)
-                checks["pinocchio"] = np.array([pin_check[op](*api(k)) for k in range(10)])
-        else:
-            name = f"{op}{n}"
-            spec_j = kernels.manifest()["kernels"][name]
-            row["kernel"] = name
-            row["ops"] = spec_j["ops"]
-            inputs = [per_pose.get(a["name"], design.get(a["name"])) for a in spec_j["inputs"]]
-            one = lambda k: [x[k] if a["name"] in per_pose else x for x, a in zip(inputs, spec_j["inputs"])]
-            row["c_batched"] = per_item(lambda: kernels.call(name, *inputs), batch, repeats)
-            row["c_single"] = per_item(loop(kernels.call, [(name, *one(k)) for k in range(single)]), single, repeats)
-            api_args = {"fk": lambda k: (q[k],), "jacobian": lambda k: (q[k],), "mass_matrix": lambda k: (q[k],),
-                        "inverse_dynamics": lambda k: (q[k], qd[k], qdd[k])}[op]
-            method = getattr(chain, op)
-            row["c_single_api"] = per_item(loop(method, [api_args(k) for k in range(single)]), single, repeats)
-            row["numpy_batched"] = per_item(lambda: NUMPY_KERNELS[name](*inputs), batch, repeats)
-            spec = sp_specs[name]
-            flat = flat_inputs(spec, inputs)
-            sfun = sympy_function(spec)
-            row["lambdify_loop"] = per_item(loop(sfun, [tuple(flat[k]) for k in range(slow)]), slow, repeats)
-            reference = kernels.call(name, *[x[:10] if a["name"] in per_pose else x
-                                             for x, a in zip(inputs, spec_j["inputs"])])[0]
-            checks = {"lambdify": np.array([sfun(*flat[k]) for k in range(10)]),
-                      "numpy": NUMPY_KERNELS[name](*[x[:10] if a["name"] in per_pose else x
-                                                     for x, a in zip(inputs, spec_j["inputs"])])}
-            if se_ok:
-                efun, backend = symengine_function(spec)
-                row["symengine_backend"] = backend
-                row["symengine_batched"] = per_item(lambda: efun(flat), batch, repeats)
-                row["symengine_single"] = per_item(loop(efun, [(flat[k],) for k in range(single)]), single, repeats)
-                checks["symengine"] = efun(flat[:10])
-            if pin_ok:
-                row["pinocchio_per_call"] = per_item(loop(pin_f[op], [api_args(k) for k in range(single)]), single,
-                                                     repeats)
-                got = np.array([pin_check[op](*api_args(k)) for k in range(10)])
-                if op == "mass_matrix":
-                    got = np.triu(got) + np.swapaxes(np.triu(got, 1), -1, -2)
-                checks["pinocchio"] = got
+        name = f"{op}{n}"
+        spec_j = kernels.manifest()["kernels"][name]
+        row["kernel"] = name
+        row["ops"] = spec_j["ops"]
+        inputs = [per_pose.get(a["name"], design.get(a["name"])) for a in spec_j["inputs"]]
+        one = lambda k: [x[k] if a["name"] in per_pose else x for x, a in zip(inputs, spec_j["inputs"])]
+        row["c_batched"] = per_item(lambda: kernels.call(name, *inputs), batch, repeats)
+        row["c_single"] = per_item(loop(kernels.call, [(name, *one(k)) for k in range(single)]), single, repeats)
+        api_args = {"fk": lambda k: (q[k],), "jacobian": lambda k: (q[k],), "mass_matrix": lambda k: (q[k],),
+                    "inverse_dynamics": lambda k: (q[k], qd[k], qdd[k]),
+                    "forward_dynamics": lambda k: (q[k], qd[k], tau[k])}[op]
+        method = getattr(chain, op)
+        row["c_single_api"] = per_item(loop(method, [api_args(k) for k in range(single)]), single, repeats)
+        row["numpy_batched"] = per_item(lambda: NUMPY_KERNELS[name](*inputs), batch, repeats)
+        spec = sp_specs[name]
+        flat = flat_inputs(spec, inputs)
+        sfun = sympy_function(spec)
+        row["lambdify_loop"] = per_item(loop(sfun, [tuple(flat[k]) for k in range(slow)]), slow, repeats)
+        reference = kernels.call(name, *[x[:10] if a["name"] in per_pose else x
+                                         for x, a in zip(inputs, spec_j["inputs"])])[0]
+        checks = {"lambdify": np.array([sfun(*flat[k]) for k in range(10)]),
+                  "numpy": NUMPY_KERNELS[name](*[x[:10] if a["name"] in per_pose else x
+                                                 for x, a in zip(inputs, spec_j["inputs"])])}
+        if se_ok:
+            efun, backend = symengine_function(spec)
+            row["symengine_backend"] = backend
+            row["symengine_batched"] = per_item(lambda: efun(flat), batch, repeats)
+            row["symengine_single"] = per_item(loop(efun, [(flat[k],) for k in range(single)]), single, repeats)
+            checks["symengine"] = efun(flat[:10])
+        if pin_ok:
+            row["pinocchio_per_call"] = per_item(loop(pin_f[op], [api_args(k) for k in range(single)]), single,
+                                                 repeats)
+            got = np.array([pin_check[op](*api_args(k)) for k in range(10)])
+            if op == "mass_matrix":
+                got = np.triu(got) + np.swapaxes(np.triu(got, 1), -1, -2)
+            checks["pinocchio"] = got
         ref = np.asarray(reference).reshape(10, -1)
         row["max_abs_difference"] = {k: float(np.max(np.abs(np.asarray(v, dtype=float).reshape(10, -1) - ref)))
                                      for k, v in checks.items()}

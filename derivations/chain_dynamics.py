@@ -352,6 +352,30 @@ def check_bias(n: int, samples: int = 2, digits: int = 30) -> float:
     return float(worst)
 
 
+def cholesky_solve(M: sp.Matrix, rhs: list, prefix: str):
+    """Steps of x = M⁻¹ rhs by Cholesky, M = L Lᵀ, and forward and back substitution.
+
+    Straight-line code for a symmetric positive definite M; where M is not, a square root of a
+    negative number gives NaN (the runtime turns that into an error). Returns (steps, x).
+    """
+    rec = _Recorder()
+    n = M.shape[0]
+    L = sp.zeros(n, n)
+    for j in range(n):
+        L[j, j] = rec.name(f"{prefix}L{j}{j}", sp.sqrt(M[j, j] - sum((L[j, k] ** 2 for k in range(j)), sp.S(0))))
+        inv = rec.name(f"{prefix}iL{j}", 1 / L[j, j])
+        for i in range(j + 1, n):
+            L[i, j] = rec.name(f"{prefix}L{i}{j}", (M[i, j] - sum((L[i, k] * L[j, k] for k in range(j)), sp.S(0))) * inv)
+        L[j, j] = inv  # below, only 1/L_jj is needed
+    y = [None] * n
+    for i in range(n):
+        y[i] = rec.name(f"{prefix}y{i}", (rhs[i] - sum((L[i, k] * y[k] for k in range(i)), sp.S(0))) * L[i, i])
+    x = [None] * n
+    for i in reversed(range(n)):
+        x[i] = rec.name(f"{prefix}x{i}", (y[i] - sum((L[k, i] * x[k] for k in range(i + 1, n)), sp.S(0))) * L[i, i])
+    return rec.steps, x
+
+
 def specs_for(n: int) -> list[KernelSpec]:
     asm = Assembly(n)
     base = list(asm.rec.steps)
@@ -361,6 +385,9 @@ def specs_for(n: int) -> list[KernelSpec]:
     b_steps, bias = rnea(asm, qd, [0] * n, gravity=True, prefix="b_")
     i_steps, tau = rnea(asm, qd, qdd, gravity=True, prefix="id_")
     c_steps, C = christoffel(asm)
+    taus = [sp.Symbol(f"tau_{k}", real=True) for k in range(1, n + 1)]
+    f_steps, qdd_fd = cholesky_solve(asm.M, [t - b for t, b in zip(taus, bias)], "fd_")
+    tau_arg = Arg("tau", (n,), "joint torques tau_i [N m]", tuple(taus))
     qdm = sp.Matrix(qd)
     kin = ("theta", "dh", "law")
     body = ("links", "legs")
@@ -381,6 +408,11 @@ def specs_for(n: int) -> list[KernelSpec]:
         KernelSpec(f"inverse_dynamics{n}", f"Joint torques tau = M theta'' + C theta' + g ({n}) of a {n}-joint chain.",
                    SOURCE, asm.inputs("theta", "qd", "qdd", "dh", "law", *body, "gravity"),
                    [Arg("tau", (n,), "joint torques [N m]", exprs=tuple(tau))], base + i_steps),
+        KernelSpec(f"forward_dynamics{n}", f"Joint accelerations theta'' = M^-1 (tau - C theta' - g) ({n}) of a "
+                   f"{n}-joint chain, by Cholesky (NaN where M is not positive definite).",
+                   SOURCE, asm.inputs("theta", "qd") + [tau_arg] + asm.inputs("dh", "law", *body, "gravity"),
+                   [Arg("qdd", (n,), "joint accelerations [rad/s^2]", exprs=tuple(qdd_fd))],
+                   base + b_steps + f_steps),
         KernelSpec(f"energy{n}", f"Kinetic and potential energy (T, V) of a {n}-joint chain.",
                    SOURCE, asm.inputs("theta", "qd", "dh", "law", *body, "gravity"),
                    [Arg("energy", (2,), "(T, V) [J]", exprs=(T, asm.V))], base),

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: d088880e31b4c953
+Content hash: 7fb7fe1823892faf
 """

@@ -22,6 +22,12 @@ def random_inputs(spec, rng: np.random.Generator, count: int) -> list[np.ndarray
         else:
             x = rng.uniform(-3.0, 3.0, shape)
         out.append(x)
+    if spec.name.startswith("forward_dynamics"):  # physical links: M is positive definite
+        links = out[[a.name for a in spec.inputs].index("links")]
+        links[..., 0] = rng.uniform(0.5, 3.0, links.shape[:-1])
+        links[..., 1:4] = rng.uniform(-0.3, 0.3, links.shape[:-1] + (3,))
+        links[..., 4:7] = rng.uniform(0.5, 2.0, links.shape[:-1] + (3,))
+        links[..., 7:10] = rng.uniform(-0.05, 0.05, links.shape[:-1] + (3,))
     if spec.name == "law_general":  # a > -b cos θ, on both sides of a = b
         theta, a, b = out
         out[1] = np.abs(b) * rng.uniform(-0.9, 3.0, a.shape)

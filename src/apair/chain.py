@@ -204,18 +204,13 @@ class AChain:
                     self.gravity)[0]
 
     def forward_dynamics(self, q, qd, tau) -> np.ndarray:
-        """(..., n): θ'' = M⁻¹(τ − C θ' − g), by a Cholesky factorisation of M (batched)."""
+        """(..., n): θ'' = M⁻¹(τ − C θ' − g), by a Cholesky factorisation of M inside one kernel."""
         (q, qd, tau), law = self._state(q, qd=qd, tau=tau)
-        M = call(f"mass_matrix{self.n}", q, self._dh, law, self._links, self._legs)[0]
-        b = call(f"bias{self.n}", q, qd, self._dh, law, self._links, self._legs, self.gravity)[0]
-        try:
-            L = np.linalg.cholesky(M)
-        except np.linalg.LinAlgError:
+        qdd = call(f"forward_dynamics{self.n}", q, qd, tau, self._dh, law, self._links, self._legs, self.gravity)[0]
+        if not np.isfinite(qdd).all():
             raise ValueError("links: the mass matrix is not positive definite at this q "
-                             "(give every moving body mass and inertia)") from None
-        rhs = (tau - b)[..., None]
-        y = np.linalg.solve(L, rhs)
-        return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
+                             "(give every moving body mass and inertia)")
+        return qdd
 
     def energy(self, q, qd) -> np.ndarray:
         """(..., 2): kinetic and potential energy (T, V) [J], legs included."""
