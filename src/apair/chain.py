@@ -117,15 +117,16 @@ class AChain:
         return q
 
     def _group_laws(self):
-        """One law-kernel call per kind of pair: (kernel, joint indices, its parameters (k, 1))."""
+        """One call per law kernel (APair.law_kernel): (kernel, joint indices, parameters (k, 1))."""
+        by_kernel: dict[str, list[int]] = {}
+        for i, p in enumerate(self.pairs):
+            if p.law_kernel is not None:
+                by_kernel.setdefault(p.law_kernel[0], []).append(i)
         groups = []
-        for kind, kernel, params in (("sinusoidal", "law_sinusoidal", lambda p: (p._h,)),
-                                     ("general", "law_general", lambda p: (p.a, p.b))):
-            idx = [i for i, p in enumerate(self.pairs) if p.kind == kind]
-            if idx:
-                values = np.array([params(self.pairs[i]) for i in idx])
-                groups.append((kernel, np.array(idx), [np.ascontiguousarray(values[:, [k]])
-                                                       for k in range(values.shape[1])]))
+        for kernel, idx in sorted(by_kernel.items()):
+            values = np.array([self.pairs[i].law_kernel[1] for i in idx])
+            groups.append((kernel, np.array(idx), [np.ascontiguousarray(values[:, [k]])
+                                                   for k in range(values.shape[1])]))
         return groups
 
     def law(self, q) -> np.ndarray:
@@ -141,9 +142,9 @@ class AChain:
             out[..., idx, :] = call(kernel, q[..., idx, None], *params)[0]
         return out
 
-    def _kernel(self, stem: str, q, law=None):
+    def _kernel(self, stem: str, q):
         q = self._q(q)
-        return call(f"{stem}{self.n}", q, self._dh, self._law(q) if law is None else law)[0]
+        return call(f"{stem}{self.n}", q, self._dh, self._law(q))[0]
 
     def fk(self, q) -> np.ndarray:
         """(..., 4, 4): the pose of frame n in the base frame; q is (n,) or (..., n)."""
@@ -155,10 +156,8 @@ class AChain:
 
     def jacobian(self, q) -> np.ndarray:
         """(..., 6, n): geometric Jacobian, base frame, rows [v; ω] (v of the origin of frame n)."""
-        law = self.law(q)
-        if self._ranged and not np.isfinite(law).all():
-            raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
-        return self._kernel("jacobian", q, law)
+        (q,), law = self._state(q)
+        return call(f"jacobian{self.n}", q, self._dh, law)[0]
 
     # ----------------------------------------------------------------------------- dynamics
     def _state(self, q, **named):

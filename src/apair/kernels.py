@@ -118,11 +118,9 @@ def _canonical(name: str, inputs) -> list[np.ndarray]:
 
 def call(name: str, *inputs) -> list[np.ndarray]:
     """Evaluate kernel `name`; inputs are float64 arrays with the kernel's trailing shapes."""
-    if (_state["resolved"] or backend()) == "c":
+    if backend() == "c":
         native = _native()[0]
-        index = _c_indices.get(name)
-        if index is None:
-            index = _c_index(native, name)
+        index = _c_index(native, name)
         out = native.call(index, *inputs)
         if out is None:  # some input needs converting or broadcasting first
             out = native.call(index, *_canonical(name, inputs))

@@ -115,12 +115,21 @@ class APair:
         """(..., 3): d(θ), d'(θ), d''(θ); broadcasts over θ."""
         return self._law(self._theta(theta, name))
 
-    def _law(self, th: np.ndarray) -> np.ndarray:
+    @property
+    def law_kernel(self) -> tuple[str, tuple[float, ...]] | None:
+        """The generated kernel of this pair's law and its parameters after θ; None for an
+        R-pair (d = 0)."""
         if self.kind == "revolute":
-            return np.zeros(th.shape + (3,))
+            return None
         if self.kind == "sinusoidal":
-            return call("law_sinusoidal", th[..., None], [self._h])[0]
-        return call("law_general", th[..., None], [self.a], [self.b])[0]
+            return "law_sinusoidal", (self._h,)
+        return "law_general", (self.a, self.b)
+
+    def _law(self, th: np.ndarray) -> np.ndarray:
+        if self.law_kernel is None:
+            return np.zeros(th.shape + (3,))
+        kernel, params = self.law_kernel
+        return call(kernel, th[..., None], *([x] for x in params))[0]
 
     def translation(self, theta) -> np.ndarray:
         """d(θ) [m], broadcasting over θ (a float for a scalar θ)."""
