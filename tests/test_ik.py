@@ -178,3 +178,91 @@ def test_matrix_and_study_conversions_agree():
     a = chain.ik(chain.fk(q))
     b = chain.ik(from_matrix(chain.fk(q)))
     np.testing.assert_allclose(a, b, atol=1e-9)
+
+
+# ----------------------------------------------------------------------------- special designs
+TWISTS = np.radians([0.0, 90.0, -90.0, 60.0])
+LENGTHS = [0.0, 0.1, 0.3]
+
+
+def special_chain(rng, n) -> apair.AChain:
+    """The constants real robots are built from: twists 0, ±90°, 60°; lengths and offsets 0, 0.1, 0.3;
+    R-pairs and sinusoidal A-pairs mixed."""
+    pairs = [apair.APair.revolute() if rng.random() < 0.5 else apair.APair(0.05, 0.04) for _ in range(n)]
+    return apair.AChain(pairs, rng.choice(LENGTHS, n), rng.choice(TWISTS, n), rng.choice(LENGTHS, n))
+
+
+def special_angles(rng, n):
+    q = rng.uniform(-np.pi, np.pi, n)
+    m = rng.random(n)
+    q[m < 0.2] = 0.0
+    q[(m >= 0.2) & (m < 0.3)] = np.pi
+    return q
+
+
+def test_issue_reproducer_special_4r():
+    R = apair.APair.revolute()
+    chain = apair.AChain([R] * 4, a=[.3, .3, .3, 0], alpha=[-np.pi / 2, -np.pi / 2, np.pi / 2, 0])
+    q = np.array([0.1, 0.2, 0.0, 0.4])
+    sol = chain.ik(chain.fk(q), full=True)
+    assert contains(sol.q, q, periods(chain)) and sol.certified
+
+
+@pytest.mark.parametrize("n, count", [(2, 60), (3, 120), (4, 240)])
+def test_special_designs_never_miss_a_full_rank_pose(n, count):
+    """Random special designs at joint values with 0 and π: a pose that fk produced, where the
+    Jacobian has full rank, is always solved; the elimination (forward or reversed) certifies
+    nearly all of them, the local fallback the rest."""
+    rng = np.random.default_rng(1400 + n)
+    done = certified = 0
+    while done < count:
+        chain = special_chain(rng, n)
+        for _ in range(3):
+            q = special_angles(rng, n)
+            if np.linalg.matrix_rank(chain.jacobian(q), tol=1e-7) < n:
+                continue
+            T = chain.fk(q)
+            sol = chain.ik(T, full=True)
+            assert contains(sol.q, q, periods(chain)), (chain, q)
+            assert_reproduce(chain, sol.q, T)
+            done += 1
+            certified += sol.certified
+    assert certified >= 0.97 * done
+
+
+def test_forward_and_reversed_eliminations_agree():
+    """The two orientations of the elimination are independent routes to the same solution set."""
+    from apair import ik
+
+    rng = np.random.default_rng(77)
+    compared = 0
+    for _ in range(40):
+        chain = special_chain(rng, 4)
+        q = special_angles(rng, 4)
+        if np.linalg.matrix_rank(chain.jacobian(q), tol=1e-7) < 4:
+            continue
+        T = chain.fk(q)
+        solver = ik.Solver(chain)
+        target = ik._study(T)
+        target[4:] /= solver.scale
+        counts = []
+        for reverse in (False, True):
+            try:
+                cands = solver._elimination(reverse).candidates(target, False)
+            except ik._Degenerate:
+                break
+            real = [c for c in cands if np.all(np.abs(np.imag(c)) <= ik.CAND_TOL * (1 + np.abs(c)))]
+            counts.append(len(ik._refine(chain, solver._elimination(reverse).angles(real), T, 1e-9)[0]))
+        if len(counts) == 2 and min(counts) > 0:
+            assert counts[0] == counts[1], (chain, q)
+            compared += 1
+    assert compared >= 20
+
+
+@pytest.mark.parametrize("n", [2, 4])
+def test_coaxial_revolute_pairs_are_refused_as_a_curve(n):
+    """Two R-pairs on one axis (a_1 = 0, α_1 = 0) turn the pose into a curve of solutions."""
+    R = apair.APair.revolute()
+    chain = apair.AChain([R] * n, a=[0.0, 0.3, 0.2, 0.1][:n], alpha=[0.0, np.pi / 2, -np.pi / 2, 0.3][:n])
+    with pytest.raises(ValueError, match="not isolated"):
+        chain.ik(chain.fk(np.full(n, 0.3)))

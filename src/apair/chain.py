@@ -250,7 +250,9 @@ class AChain:
         Chains of 1 to 4 sinusoidal A-pairs or R-pairs, by kinematic mapping (see apair.ik): the
         left half's constraint variety on the right part's image, eliminated to eigenvalue and
         univariate problems. Angles in (−2π, 2π] for A-pairs, (−π, π] for R-pairs.
-        full=True returns an `apair.ik.Solution` (q, error, candidates, complex_count).
+        full=True returns an `apair.ik.Solution`: q, error, candidates, complex_count, `inside`
+        (whether each solution is within `limits`) and `certified` (False where the elimination
+        degenerated and a local search supplied the solutions: the set may be incomplete).
         """
         from .ik import Solver
 
@@ -258,10 +260,11 @@ class AChain:
         if self._ik is None:
             self._ik = Solver(self)
         sol = self._ik.solve(T, tol=tol, count_complex=full)
+        inside = self.within_limits(sol.q)
         if within_limits:
-            keep = self.within_limits(sol.q)
-            sol = dataclasses.replace(sol, q=sol.q[keep], error=sol.error[keep])
-        return sol if full else sol.q
+            sol = dataclasses.replace(sol, q=sol.q[inside], error=sol.error[inside])
+            inside = inside[inside]
+        return dataclasses.replace(sol, inside=inside) if full else sol.q
 
     def workspace(self, samples: int = 300_000, resolution: int = 24, rounds: int = 4, poses: bool = False,
                   engine=None, seed: int = 0, progress=None):

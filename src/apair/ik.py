@@ -18,9 +18,23 @@ parameter is shifted by a random angle (a Möbius substitution) so that no solut
   in u_3) is never expanded: the Sylvester matrix in u_4, whose rows have degree 4 or 8 in u_3, is
   linearised by rows into a 64 × 64 eigenvalue problem. Each real eigenvalue u_3 gives the common
   real roots u_4 of f and g; a pair is kept if every quadric of the left half vanishes on its
-  image, and the left half is then solved for W(u_3, u_4) as above. Where the rotation condition
-  holds on the whole image (parallel axes, as in examples/4a_chain.toml), f is a second random
-  combination of the quadrics (a 128 × 128 problem).
+  image, and the left half is then solved for W(u_3, u_4) as above.
+
+Special designs (twists of 0 and 90°, zero lengths: what robots are built from) make parts of this
+degenerate, and each has its own remedy:
+- the rotation condition holds on the whole image (parallel axes, as in examples/4a_chain.toml),
+  or f and g share a curve: other random combinations of the quadrics take their place; where
+  every pair shares a curve, the u_3 are the eigenvalues of the singular pencil's regular part
+  (a random rank completion, `_regular_eigenvalues`);
+- at some u_3 every u_4 satisfies f (or g): each u_3 gets the common roots u_4 of *all* the
+  left half's quadrics (`_right_pairs`), not of f and g alone;
+- joints 1 and 2 on one axis (a_1 = α_1 = 0): u_1 and u_2 come together from a bivariate
+  system (`_solve_coaxial`);
+- what still degenerates is solved on the reversed chain (K_n·T̃ = Π P̃ K̃, the halves swapped);
+  where both orientations fail (or find nothing for a pose within reach), a batched
+  Levenberg-Marquardt search from 64 seeds finds the solutions, and the answer says that it is
+  not certified complete (`Solution.certified`). A curve of solutions (two R-pairs on one axis)
+  is refused with a ValueError.
 
 Every real candidate is checked with the chain's own fk kernel, refined by up to two Gauss-Newton
 steps where it is not already accurate to 1e-3·tol, and kept only if fk(q) reproduces T to `tol`
@@ -42,8 +56,10 @@ from .study import _qmul, conjugate, from_matrix, multiply, normalise, to_matrix
 
 SEED = 46  # fixed: the parameter shifts and random combinations are reproducible
 OUTSIDE = [1, 2, 5, 6]  # components that vanish on the pair subalgebra
+INSIDE = [0, 3, 4, 7]  # the subalgebra's components: 1, k, ε, εk
 ROOT_RTOL = 1e-6  # relative residual under which a root is a candidate (verification decides)
 REAL_TOL = 1e-6  # |Im u| / (1 + |u|) under which a root is taken as real
+CAND_TOL = 1e-4  # the same for an intermediate root (multiple roots lose half their digits)
 
 
 # ----------------------------------------------------------------------------- polynomials
@@ -163,7 +179,8 @@ class _Joint:
         return _wrap(4 * np.arctan(u) + self.delta, 4 * np.pi)
 
 
-def _joint(chain, i: int, scale: float, delta: float) -> _Joint:
+def _pair_curve(chain, i: int, scale: float, delta: float) -> np.ndarray:
+    """P_i(u) (D+1, 8) = Rz(φ_i)·Tz(c_i)·(pair point in the parameter shifted by delta)."""
     pair = chain.pairs[i]
     if pair.kind == "revolute":
         tau = math.tan(delta / 2)
@@ -173,16 +190,43 @@ def _joint(chain, i: int, scale: float, delta: float) -> _Joint:
         tau = math.tan(delta / 4)
         base = _quartic() @ np.array([1.0, pair.amplitude / scale])
     P = _mobius(base, tau)
-    P = multiply(multiply(_rot(2, chain.theta_offset[i]), _trans(2, chain.offset[i] / scale)), P)
+    return multiply(multiply(_rot(2, chain.theta_offset[i]), _trans(2, chain.offset[i] / scale)), P)
+
+
+def _link(chain, i: int, scale: float) -> np.ndarray:
+    """K_i = Tx(a_i)·Rx(α_i), the joint's constant part."""
+    return multiply(_trans(0, chain.a[i] / scale), _rot(0, chain.alpha[i]))
+
+
+def _make_joint(kind: str, delta: float, P: np.ndarray, K: np.ndarray) -> _Joint:
     x = P[:, :4]
-    if pair.kind != "revolute":  # x carries the factor (1 + u²) (up to a constant after the shift)
+    if kind != "revolute":  # x carries the factor (1 + u²) (up to a constant after the shift)
         Pn = np.polynomial.polynomial
         parts = [Pn.polydiv(x[:, j], [1.0, 0.0, 1.0]) for j in range(4)]
         if max(np.abs(r).max() for _, r in parts) > 1e-12 * np.abs(x).max():
             raise AssertionError("the pair's rotation part lost its (1 + u^2) factor")
         x = np.stack([np.pad(q, (0, 3 - len(q))) for q, _ in parts], 1)
-    K = multiply(_trans(0, chain.a[i] / scale), _rot(0, chain.alpha[i]))
-    return _Joint(pair.kind, delta, P, _qmul(x, K[:4]), K, conjugate(K))
+    return _Joint(kind, delta, P, _qmul(x, K[:4]), K, conjugate(K))
+
+
+def _chain_joints(chain, scale: float, deltas, reverse: bool):
+    """The joints as the elimination sees them, and the map of the target pose.
+
+    Forward: A_i = P_i(u)·K_i, target T. Reversed: T = Π P_i K_i gives K_n·T̃ = Π_j P'_j K'_j
+    with P'_j = P̃_{n+1−j} (still in the pair subalgebra, in the same parameter) and
+    K'_j = K̃_{n−j}, K'_n = 1: the same problem with the chain's halves swapped, which is
+    regular where the forward split degenerates (e.g. where joints 1 and 2 are parallel)."""
+    n = chain.n
+    kinds = [p.kind for p in chain.pairs]
+    P = [_pair_curve(chain, i, scale, deltas[i]) for i in range(n)]
+    K = [_link(chain, i, scale) for i in range(n)]
+    if not reverse:
+        return [_make_joint(kinds[i], deltas[i], P[i], K[i]) for i in range(n)], None
+    one = np.zeros(8)
+    one[0] = 1.0
+    joints = [_make_joint(kinds[i], deltas[i], conjugate(P[i]), conjugate(K[i - 1]) if i else one)
+              for i in reversed(range(n))]
+    return joints, K[n - 1]
 
 
 class _Degenerate(Exception):
@@ -195,16 +239,24 @@ class Solution:
     """All real solutions `q` (k, n) of one pose, with the counts behind them.
 
     complex_count: solutions over the complex numbers found by the elimination (None unless
-    asked for); candidates: real candidates examined; error: fk error of each solution."""
+    asked for); candidates: real candidates examined; error: fk error of each solution;
+    certified: False when the elimination degenerated (or found nothing) at this pose and the
+    solutions come from the local fallback search, so that the set may be incomplete."""
 
     q: np.ndarray
     error: np.ndarray
     candidates: int
     complex_count: int | None = None
+    certified: bool = True
+    inside: np.ndarray | None = None  # (k,) within the chain's joint limits (set by AChain.ik)
 
 
 class Solver:
-    """The inverse kinematics of one chain; the design-dependent work is done once."""
+    """The inverse kinematics of one chain; the design-dependent work is done once.
+
+    The elimination runs on the chain as given; where it degenerates (or finds nothing for a pose
+    within reach) it runs on the reversed chain, and where that degenerates too a batched local
+    search from many seeds gives the solutions, marked as not certified complete."""
 
     def __init__(self, chain, seed: int = SEED):
         n = chain.n
@@ -216,8 +268,53 @@ class Solver:
                                  "needs sinusoidal A-pairs or R-pairs")
         self.chain = chain
         self.scale = _scale(chain)
+        self.seed = seed
+        self._eliminations = {}
+
+    def _elimination(self, reverse: bool) -> "_Elimination":
+        if reverse not in self._eliminations:
+            self._eliminations[reverse] = _Elimination(self.chain, self.scale, reverse, self.seed)
+        return self._eliminations[reverse]
+
+    def solve(self, T: np.ndarray, tol: float = 1e-9, count_complex: bool = False) -> Solution:
+        target = _study(T)
+        target[4:] /= self.scale
+        Tm = _matrix(T)
+        n = self.chain.n
+        degenerate = []
+        for reverse in (False, True) if n >= 2 else (False,):
+            try:
+                cands = self._elimination(reverse).candidates(target, count_complex)
+            except _Degenerate as exc:
+                degenerate.append(str(exc))
+                continue
+            # points where a joint's rotation part vanishes (u = ±i, isotropic) are not displacements
+            cands = [c for c in cands if np.all(np.abs(1 + c * c) > 1e-3 * (1 + np.abs(c) ** 2))]
+            count = len(_dedupe_complex(cands)) if count_complex else None
+            real = [c for c in cands if np.all(np.abs(np.imag(c)) <= CAND_TOL * (1 + np.abs(c)))]
+            q = self._elimination(reverse).angles(real)
+            q, err = _refine(self.chain, q, Tm, tol)
+            if len(q) or not _near_reach(self.chain, Tm):
+                return Solution(q, err, len(real), count)
+        # every elimination degenerated, or found nothing for a pose within reach: local search
+        q, err = _refine(self.chain, local_search(self.chain, Tm), Tm, tol)
+        if len(q) and _on_continuum(self.chain, q[0], Tm, tol):
+            why = f" ({degenerate[0]})" if degenerate else ""
+            raise ValueError(f"T: the solutions at this pose are not isolated{why}: they form a curve (e.g. "
+                             "two R-pairs on one axis)")
+        certified = len(q) == 0 and not degenerate  # the elimination's "none" stands
+        return Solution(q, err, 0, None, certified=certified)
+
+
+class _Elimination:
+    """The elimination for one orientation of the chain (forward or reversed, see _chain_joints)."""
+
+    def __init__(self, chain, scale: float, reverse: bool, seed: int):
+        n = chain.n
+        self.chain, self.scale, self.reverse = chain, scale, reverse
         self.rng = np.random.default_rng(seed)
-        self.joints = [_joint(chain, i, self.scale, self.rng.uniform(-np.pi, np.pi)) for i in range(n)]
+        deltas = self.rng.uniform(-np.pi, np.pi, n)
+        self.joints, self.pre = _chain_joints(chain, scale, deltas, reverse)
         j1 = self.joints[0]
         if n >= 2:  # Z(u_1) = K_1⁻¹·P̃_1(u_1)·W·K_2⁻¹ = Σ u_1^m Zmap[m] W
             right = _right(self.joints[1].Kinv)
@@ -236,8 +333,8 @@ class Solver:
             self.Qx = np.tensordot(self.rng.standard_normal(len(Qx)), Qx, 1)
             self.weights = self.rng.standard_normal(len(Q))
             self.weights2 = self.rng.standard_normal(len(Q))
+            self.weights3 = self.rng.standard_normal(len(Q))
 
-    # -- design-dependent
     def _half_quadrics(self):
         """Quadrics through the left half's poses (all, and in x alone) by SVD on sampled points."""
         j1, j2 = self.joints[:2]
@@ -246,27 +343,20 @@ class Solver:
         pts /= np.linalg.norm(pts, axis=1, keepdims=True)
         return _quadric_forms(pts), _quadric_forms(pts[:, :4])
 
-    # -- per pose
-    def solve(self, T: np.ndarray, tol: float = 1e-9, count_complex: bool = False) -> Solution:
-        target = _study(T)
-        target[4:] /= self.scale
+    def candidates(self, target: np.ndarray, count_complex: bool) -> list[np.ndarray]:
+        """Complex parameter vectors (in this elimination's joint order) for a unit target."""
+        if self.pre is not None:
+            target = multiply(self.pre, conjugate(target))
         n = self.chain.n
-        try:
-            cands = self._solve_left(target, n) if n <= 2 else self._solve_right(target, count_complex)
-        except _Degenerate as exc:
-            raise ValueError(f"T: the solutions at this pose are not isolated ({exc}); the chain's "
-                             "design is degenerate for inverse kinematics here") from None
-        # points where a joint's rotation part vanishes (u = ±i, isotropic) are not displacements
-        cands = [c for c in cands if np.all(np.abs(1 + c * c) > 1e-3 * (1 + np.abs(c) ** 2))]
-        count = len(_dedupe_complex(cands)) if count_complex else None
-        real = [c for c in cands if np.all(np.abs(np.imag(c)) <= REAL_TOL * (1 + np.abs(c)))]
-        if real:
-            U = np.real(np.array(real))
-            q = np.stack([j.theta(U[:, i]) for i, j in enumerate(self.joints)], 1)
-        else:
-            q = np.zeros((0, n))
-        q, err = _refine(self.chain, q, _matrix(T), tol)
-        return Solution(q, err, len(real), count)
+        return self._solve_left(target, n) if n <= 2 else self._solve_right(target, count_complex)
+
+    def angles(self, real: list) -> np.ndarray:
+        """Joint angles (k, n) in the chain's order from real parameter vectors."""
+        if not real:
+            return np.zeros((0, self.chain.n))
+        U = np.real(np.array(real))
+        q = np.stack([j.theta(U[:, i]) for i, j in enumerate(self.joints)], 1)
+        return q[:, ::-1] if self.reverse else q
 
     def _solve_left(self, W: np.ndarray, n: int) -> list[np.ndarray]:
         """Parameters (u_1[, u_2]) with A_1 (A_2) ∝ W, complex; W may be complex."""
@@ -274,16 +364,83 @@ class Solver:
         if n == 1:
             return [np.array([u]) for u in _on_curve(j1, multiply(W, j1.Kinv), self.rng)]
         Zc = self.Zmap @ W  # (D1+1, 8)
+        if np.abs(Zc[:, OUTSIDE]).max() <= 1e-10 * np.abs(Zc).max():
+            return self._solve_coaxial(Zc)
         out = []
         for u1 in _common_roots(Zc[:, OUTSIDE].T, self.rng):
             Z = (u1 ** np.arange(len(Zc))) @ Zc
             out += [np.array([u1, u2]) for u2 in _on_curve(self.joints[1], Z, self.rng)]
         return out
 
+    def _solve_coaxial(self, Zc: np.ndarray) -> list[np.ndarray]:
+        """Joints 1 and 2 on one axis (a_1 = 0, α_1 = 0): Z(u_1) lies in the pair subalgebra for
+        every u_1, so u_1 and u_2 come together from Z(u_1) ∝ P_2(u_2): the 2×2 minors of the
+        subalgebra components are bivariate; two random combinations are eliminated (hidden
+        variable u_1), and each u_1 gets the common roots u_2 of all minors. Two R-pairs on one
+        axis have a curve of solutions (the resultant vanishes identically): _Degenerate."""
+        P2 = self.joints[1].P
+        a, b = np.array([(a, b) for i, a in enumerate(INSIDE) for b in INSIDE[i + 1:]]).T
+        minors = (Zc[:, None, a] * P2[None, :, b] - Zc[:, None, b] * P2[None, :, a]).transpose(2, 0, 1)
+        f, g = (np.tensordot(self.rng.standard_normal(len(minors)), minors, 1) for _ in range(2))
+        out = []
+        for u1 in _hidden_variable(f, g, self.rng):
+            row = np.einsum("kij,i->kj", minors, u1 ** np.arange(len(Zc)))
+            try:
+                out += [np.array([u1, u2]) for u2 in _common_roots(row, self.rng)]
+            except _Degenerate:
+                continue
+        return out
+
     def _quadric_image(self, C: np.ndarray, weights: np.ndarray) -> np.ndarray:
         """Coefficients (u_3^i u_4^j) of Σ_k w_k Q_k(W(u_3, u_4)) for the left half's quadrics Q_k."""
         Q = np.tensordot(weights, self.Q, 1)
         return np.real(_bivariate(C, C, lambda A, B: np.einsum("...a,ab,...b->...", A, Q, B)))
+
+    def _resultant_roots(self, C: np.ndarray, X: np.ndarray) -> np.ndarray:
+        """Every u_3 at which two conditions on W(u_3, u_4) have a common root u_4: the rotation
+        condition f (bidegree (4, 4)) with a random combination g of the quadrics, else (where f
+        vanishes on the whole image, or f and g share a curve, as special designs make them)
+        other combinations, until the resultant is not identically zero; where every pair shares
+        a curve, the regular part of the first pair's pencil."""
+        f = np.real(_bivariate(X, X, lambda A, B: np.einsum("...a,ab,...b->...", A, self.Qx, B)))
+        g1, g2, g3 = (self._quadric_image(C, w) for w in (self.weights, self.weights2, self.weights3))
+        tries = [(g1, g2), (g2, g3)]
+        if np.abs(f).max() > 1e-12 * np.abs(X).max() ** 2 * np.abs(self.Qx).max():
+            tries = [(f, g1), (f, g2)] + tries
+        for a, b in tries:
+            try:
+                return _hidden_variable(a, b, self.rng, singular_ok=False)
+            except _Degenerate:
+                continue
+        return _hidden_variable(*tries[0], self.rng)  # every pair shares a curve: the regular part
+
+    def _right_pairs(self, u3s: np.ndarray, C: np.ndarray, real: bool):
+        """For each u_3, the u_4 where every quadric of the left half vanishes on W(u_3, u_4) (their
+        common roots: complete even where f or g alone vanishes for all u_4 at that u_3); the
+        pairs (r, 2) and their images W (r, 8). A u_3 at which all of them vanish for every u_4
+        (a curve of candidates, never a solution of a full-rank pose) is skipped."""
+        pairs, images = [], []
+        if len(u3s) == 0:
+            return np.zeros((0, 2)), np.zeros((0, 8))
+        Cu = np.einsum("ri,ija->rja", u3s[:, None] ** np.arange(C.shape[0]), C)  # (R, D4+1, 8)
+        outer = np.einsum("rja,kab,rlb->rkjl", Cu, self.Q, Cu)
+        D = Cu.shape[1]
+        polys = np.zeros(outer.shape[:2] + (2 * D - 1,), dtype=outer.dtype)
+        for j in range(D):
+            polys[:, :, j: j + D] += outer[:, :, j, :]
+        for u3, P, Wc in zip(u3s, polys, Cu):
+            try:
+                u4s = _common_roots(P, self.rng)
+            except _Degenerate:
+                continue
+            if real:
+                u4s = u4s[np.abs(u4s.imag) <= CAND_TOL * (1 + np.abs(u4s))].real
+            for u4 in u4s:
+                pairs.append([u3, u4])
+                images.append((u4 ** np.arange(D)) @ Wc)
+        if not pairs:
+            return np.zeros((0, 2)), np.zeros((0, 8))
+        return np.array(pairs), np.array(images)
 
     def _solve_right(self, T: np.ndarray, count_complex: bool) -> list[np.ndarray]:
         """Candidates for 3 and 4 joints: the right part's parameters from the left half's quadrics
@@ -296,22 +453,10 @@ class Solver:
             rights = [np.array([u3]) for u3 in _common_roots(G, self.rng)]
             images = [(r[0] ** np.arange(len(C))) @ C for r in rights]
         else:
-            X = self.ximage @ LT[:4, :4].T
-            f = np.real(_bivariate(X, X, lambda A, B: np.einsum("...a,ab,...b->...", A, self.Qx, B)))
-            g = self._quadric_image(C, self.weights)
-            if np.abs(f).max() <= 1e-12 * np.abs(X).max() ** 2 * np.abs(self.Qx).max():
-                # the rotation condition holds on the whole image (e.g. parallel axes): use a
-                # second combination of the quadrics instead
-                f = self._quadric_image(C, self.weights2)
-            u3s = _hidden_variable(f, g)
+            u3s = self._resultant_roots(C, self.ximage @ LT[:4, :4].T)
             if not count_complex:
-                u3s = u3s[np.abs(u3s.imag) <= REAL_TOL * (1 + np.abs(u3s))].real
-            rights, images = _second_roots(f, g, u3s, C, real=not count_complex)
-            # a resultant root of f and g is kept only if every quadric of the left half vanishes
-            Wn = images / np.linalg.norm(images, axis=1, keepdims=True)
-            res = np.abs(np.einsum("ra,qab,rb->rq", Wn, self.Q, Wn)).max(axis=1, initial=0.0)
-            keep = res <= ROOT_RTOL
-            rights, images = rights[keep], images[keep]
+                u3s = u3s[np.abs(u3s.imag) <= CAND_TOL * (1 + np.abs(u3s))].real
+            rights, images = self._right_pairs(u3s, C, real=not count_complex)
         out = []
         for right, W in zip(rights, images):
             out += [np.concatenate([left, right]) for left in self._solve_left(W, 2)]
@@ -377,19 +522,22 @@ def _linearisation(degs: tuple):
     return np.arange(len(cols)), cols, [(int(offs[i]), d) for i, d in enumerate(degs)]
 
 
-def _hidden_variable(f: np.ndarray, g: np.ndarray) -> np.ndarray:
+def _hidden_variable(f: np.ndarray, g: np.ndarray, rng, singular_ok: bool = True) -> np.ndarray:
     """All u with f(u, v) = g(u, v) = 0 for some v (coefficients [i, j] of u^i v^j): the zeros of
     the Sylvester matrix in v, a matrix polynomial in u whose rows have the degrees of f and g,
-    linearised by rows (size Σ row degrees = the resultant's degree bound)."""
+    linearised by rows (size Σ row degrees = the resultant's degree bound). Where the pencil is
+    singular (f and g share a curve) its regular part's eigenvalues are returned, or, with
+    singular_ok=False, _Degenerate is raised."""
     df, dg = f.shape[1] - 1, g.shape[1] - 1
     N = df + dg
+    dtype = np.result_type(f, g, float)  # complex where the pose's image is complex
     rows = []  # (coefficients in u (d+1, N)) per row
     for r in range(dg):
-        row = np.zeros((f.shape[0], N))
+        row = np.zeros((f.shape[0], N), dtype)
         row[:, r: r + df + 1] = f
         rows.append(row)
     for r in range(df):
-        row = np.zeros((g.shape[0], N))
+        row = np.zeros((g.shape[0], N), dtype)
         row[:, r: r + dg + 1] = g
         rows.append(row)
     degs = tuple(len(r) - 1 for r in rows)
@@ -397,13 +545,20 @@ def _hidden_variable(f: np.ndarray, g: np.ndarray) -> np.ndarray:
         raise _Degenerate("a Sylvester row is constant in the hidden variable")
     shift_rows, shift_cols, blocks = _linearisation(degs)
     size = sum(degs)
-    A = np.zeros((size, size))
-    B = np.zeros((size, size))
+    A = np.zeros((size, size), dtype)
+    B = np.zeros((size, size), dtype)
     A[shift_rows, shift_cols + 1] = 1.0
     B[shift_rows, shift_cols] = 1.0
     for (lo, d), row in zip(blocks, rows):  # the last N rows: Σ_i row_i(u)ᵀ w_i = 0
         A[size - N:, lo: lo + d] = -row[:d].T
         B[size - N:, lo + d - 1] = row[d]
+    z = np.exp(2j * np.pi * rng.random())  # a random point on the unit circle
+    sv = np.linalg.svd(np.stack([z ** np.arange(len(r)) @ r for r in rows]), compute_uv=False)
+    deficit = int(np.count_nonzero(sv <= 1e-11 * sv[0]))
+    if deficit:  # f and g share a curve: the resultant vanishes identically
+        if not singular_ok:
+            raise _Degenerate("f and g have a common factor")
+        return _regular_eigenvalues(A, B, deficit, rng)
     lead = B[size - N:, [lo + d - 1 for lo, d in blocks]]  # B is I plus this block, permuted
     if np.linalg.cond(lead) < 1e10:
         return np.linalg.eigvals(np.linalg.solve(B, A))
@@ -411,37 +566,30 @@ def _hidden_variable(f: np.ndarray, g: np.ndarray) -> np.ndarray:
     return w[np.isfinite(w)]
 
 
-def _second_roots(f, g, u3s, C, real: bool):
-    """For each u_3, the common roots u_4 of f(u_3, ·) and g(u_3, ·) (batched companion
-    eigenvalues of f(u_3, ·), checked on g); returns the pairs (r, 2) and their images W (r, 8)."""
-    if len(u3s) == 0:
-        return np.zeros((0, 2)), np.zeros((0, 8))
-    fu = (u3s[:, None] ** np.arange(f.shape[0])) @ f  # (R, df+1), ascending in u_4
-    gu = (u3s[:, None] ** np.arange(g.shape[0])) @ g
-    d = f.shape[1] - 1
-    lead = fu[:, d]
-    ok = np.abs(lead) > 1e-12 * np.abs(fu).max(axis=1)
-    fu, gu, u3s, lead = fu[ok], gu[ok], u3s[ok], lead[ok]
-    comp = np.zeros((len(fu), d, d), dtype=fu.dtype)
-    comp[:, 1:, :-1] = np.eye(d - 1)
-    comp[:, :, -1] = -fu[:, :d] / lead[:, None]
-    u4 = np.linalg.eigvals(comp)  # (R, d)
-    u3 = np.repeat(u3s, d)
-    u4 = u4.ravel()
-    both = np.zeros((len(u4), 2, max(fu.shape[1], gu.shape[1])), dtype=complex)
-    both[:, 0, : fu.shape[1]] = np.repeat(fu, d, axis=0)
-    both[:, 1, : gu.shape[1]] = np.repeat(gu, d, axis=0)
-    pw = u4[:, None] ** np.arange(both.shape[2])
-    num = np.abs(np.einsum("rkm,rm->rk", both, pw)).max(axis=1)
-    den = np.einsum("rm,rm->r", np.abs(both).max(axis=1), np.abs(pw))
-    keep = num <= ROOT_RTOL * den
-    if real:
-        keep &= np.abs(u4.imag) <= REAL_TOL * (1 + np.abs(u4))
-    u3, u4 = u3[keep], u4[keep]
-    if real:
-        u4 = u4.real
-    W = np.einsum("ri,rj,ija->ra", u3[:, None] ** np.arange(C.shape[0]), u4[:, None] ** np.arange(C.shape[1]), C)
-    return np.stack([u3, u4], 1), W
+def _regular_eigenvalues(A: np.ndarray, B: np.ndarray, k: int, rng, tol: float = 1e-5) -> np.ndarray:
+    """The finite eigenvalues of the regular part of a singular pencil A − λB of normal rank
+    size − k (where the rank drops below that: here, the u_3 with a common root besides the
+    shared curve), by a random rank-k completion (Hochstenbach, Mehl and Plestenjak, SIMAX 2019):
+    the pencil A + U Dₐ V*, B + U D_b V* is regular; its eigenvalues of the true part keep
+    right eigenvectors x with V*x = 0 and left ones y with U*y = 0, the others are random."""
+    size = len(A)
+
+    def crandn(*shape):  # real where the pencil is: the same test, in real arithmetic
+        if np.iscomplexobj(A):
+            return rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
+        return rng.standard_normal(shape)
+
+    U, Vh = crandn(size, k), crandn(k, size)
+    At = A + U @ np.diag(crandn(k)) @ Vh
+    Bt = B + U @ np.diag(crandn(k)) @ Vh
+    if np.linalg.cond(Bt) < 1e10:  # the standard problem: right eigenvectors, left ones from X⁻¹
+        w, vr = np.linalg.eig(np.linalg.solve(Bt, At))
+        vl = (np.linalg.inv(vr) @ np.linalg.inv(Bt)).conj().T
+    else:
+        w, vl, vr = scipy.linalg.eig(At, Bt, left=True, right=True)
+    right = np.linalg.norm(Vh @ vr, axis=0) / (np.linalg.norm(Vh) * np.linalg.norm(vr, axis=0))
+    left = np.linalg.norm(U.conj().T @ vl, axis=0) / (np.linalg.norm(U) * np.linalg.norm(vl, axis=0))
+    return w[np.isfinite(w) & (right <= tol) & (left <= tol)]
 
 
 def _dedupe_complex(cands, tol: float = 1e-6) -> list:
@@ -487,20 +635,14 @@ def _refine(chain, q: np.ndarray, T: np.ndarray, tol: float):
     if len(q) == 0:
         return q, np.zeros(0)
 
-    def error(q):
-        F = chain.fk(q)
-        dp = T[:3, 3] - F[:, :3, 3]
-        dw = 0.5 * np.cross(F[:, :3, :3], T[:3, :3], axisa=1, axisb=0, axisc=1).sum(axis=2)
-        return np.concatenate([dp, dw], 1), np.abs(F - T).max(axis=(1, 2))
-
-    e, err = error(q)
+    e, err = _pose_error(chain, q, T)
     for _ in range(2):
         if np.all(err <= 1e-3 * tol):
             break
-        J = chain.jacobian(q)
+        J = chain.jacobian(q) * _weights(chain)
         step = np.einsum("kij,kj->ki", np.linalg.pinv(J, rcond=1e-12), e)
         q2 = q + step
-        e2, err2 = error(q2)
+        e2, err2 = _pose_error(chain, q2, T)
         better = err2 < err
         q, e, err = np.where(better[:, None], q2, q), np.where(better[:, None], e2, e), np.where(better, err2, err)
     periods = _periods(chain)
@@ -524,32 +666,92 @@ def _refine(chain, q: np.ndarray, T: np.ndarray, tol: float):
     return out[order], errs[order]
 
 
-def distance(chain, T, starts: int = 24, seed: int = 0) -> tuple[float, float, np.ndarray]:
-    """How far a pose is from the chain's reach: (position error [m], rotation error [rad], q) at
-    the best of `starts` local least-squares fits of fk(q) to T (pose error weighted by the chain's
-    length scale). An estimate for reporting unreachable poses, not part of the exact solver."""
-    from scipy.optimize import least_squares
+def _rank(chain, q: np.ndarray) -> np.ndarray:
+    """Numerical rank of the Jacobian at each joint vector (k, n), scaled by the chain's size."""
+    return np.linalg.matrix_rank(chain.jacobian(q) * _weights(chain), tol=1e-8)
 
+
+def _weights(chain) -> np.ndarray:
+    """(6, 1): the rows of a Jacobian or pose error made dimensionless (positions / scale)."""
+    return np.array([1 / _scale(chain)] * 3 + [1.0] * 3)[:, None]
+
+
+def _near_reach(chain, T: np.ndarray) -> bool:
+    """Whether T's position is within the chain's crude reach bound (Σ |a| + |c| + 2h from the
+    base): outside it no local search is needed to call the pose unreachable."""
+    reach = sum(abs(a) + abs(c) + 2 * p.amplitude for a, c, p in zip(chain.a, chain.offset, chain.pairs))
+    return bool(np.linalg.norm(T[:3, 3]) <= 1.01 * reach + 1e-9 * _scale(chain))
+
+
+def _pose_error(chain, q: np.ndarray, T: np.ndarray):
+    """(k, 6) pose error [Δp/scale; Δω] of fk(q) against T and (k,) the largest entry of the 4×4
+    difference."""
+    F = chain.fk(q)
+    dp = (T[:3, 3] - F[:, :3, 3]) / _scale(chain)
+    dw = 0.5 * np.cross(F[:, :3, :3], T[:3, :3], axisa=1, axisb=0, axisc=1).sum(axis=2)
+    return np.concatenate([dp, dw], 1), np.abs(F - T).max(axis=(1, 2))
+
+
+def _on_continuum(chain, q: np.ndarray, T: np.ndarray, tol: float) -> bool:
+    """Whether the solution q lies on a curve of solutions: where the Jacobian is rank-deficient,
+    a step along its null space, corrected back onto the pose, lands on another solution."""
+    if _rank(chain, q[None])[0] == chain.n:
+        return False
+    v = np.linalg.svd(chain.jacobian(q) * _weights(chain))[2][-1]
+    moved = local_search(chain, T, start=(q + 1e-2 * v)[None])
+    _, err = _pose_error(chain, moved, T)
+    return bool(err[0] <= tol and np.abs(moved[0] - q).max() > 1e-3)
+
+
+def local_search(chain, T: np.ndarray, seeds: int = 64, iterations: int = 60, seed: int = SEED,
+                 bounds: np.ndarray | None = None, start: np.ndarray | None = None) -> np.ndarray:
+    """Levenberg-Marquardt on the pose error from `seeds` joint vectors drawn uniformly (in
+    `bounds` (n, 2), default each joint's period), all at once over the batched fk and Jacobian
+    kernels (or from the rows of `start`); returns the end points, kept inside the bounds. Not
+    complete: the fallback where the elimination degenerates, and the nearest-pose search."""
+    periods = _periods(chain)
+    if bounds is None:
+        bounds = np.stack([-periods / 2, periods / 2], 1)
+        for i, p in enumerate(chain.pairs):
+            if p.theta_limit is not None:
+                bounds[i] = -p.theta_limit, p.theta_limit
+    lo, hi = bounds[:, 0], bounds[:, 1]
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(lo, hi, (seeds, chain.n)) if start is None else np.clip(start, lo, hi)
+    seeds = len(q)
+    W = _weights(chain)
+    lam = np.full(seeds, 1e-3)
+    e, _ = _pose_error(chain, q, T)
+    cost = np.sum(e * e, axis=1)
+    for _ in range(iterations):
+        J = chain.jacobian(q) * W
+        JtJ = np.einsum("kia,kib->kab", J, J)
+        g = np.einsum("kia,ki->ka", J, e)
+        A = JtJ + lam[:, None, None] * (np.eye(chain.n) * (np.einsum("kaa->ka", JtJ)[:, :, None] + 1e-12))
+        step = np.einsum("kab,kb->ka", np.linalg.pinv(A), g)
+        q2 = np.clip(q + step, lo, hi)
+        e2, _ = _pose_error(chain, q2, T)
+        cost2 = np.sum(e2 * e2, axis=1)
+        better = cost2 < cost
+        q, e, cost = np.where(better[:, None], q2, q), np.where(better[:, None], e2, e), np.where(better, cost2, cost)
+        lam = np.where(better, lam / 3, lam * 4)
+        if np.all(cost < 1e-28):
+            break
+    return q
+
+
+def distance(chain, T, starts: int = 64, seed: int = SEED) -> tuple[float, float, np.ndarray]:
+    """How far a pose is from the chain's reach inside its joint limits (`chain.limits`):
+    (position error [m], rotation error [rad], q) at the best of `starts` batched
+    Levenberg-Marquardt fits of fk(q) to T (pose error weighted by the chain's length scale), a
+    bounded amount of work (60 iterations of one batched fk and Jacobian call). An estimate for
+    reporting unreachable poses, not part of the exact solver."""
     _study(T)  # validates
     Tm = _matrix(T)
-    scale = _scale(chain)
-    rng = np.random.default_rng(seed)
-    periods = _periods(chain)
-    lo = np.array([-(p.theta_limit or per / 2) for p, per in zip(chain.pairs, periods)])
-    bounds = (lo, -lo) if any(p.theta_limit for p in chain.pairs) else (-np.inf, np.inf)
-
-    def residual(q):
-        F = chain.fk(q)
-        return np.concatenate([(F[:3, 3] - Tm[:3, 3]) / scale, (F[:3, :3] - Tm[:3, :3]).ravel() / 2])
-
-    best = None
-    for _ in range(starts):
-        q0 = rng.uniform(lo, -lo) * 0.999
-        r = least_squares(residual, q0, bounds=bounds, xtol=1e-14, ftol=1e-14)
-        if best is None or r.cost < best.cost:
-            best = r
-    F = chain.fk(best.x)
+    q = local_search(chain, Tm, seeds=starts, seed=seed, bounds=chain.limits)
+    e, _ = _pose_error(chain, q, Tm)
+    best = q[int(np.argmin(np.sum(e * e, axis=1)))]
+    F = chain.fk(best)
     dp = float(np.linalg.norm(F[:3, 3] - Tm[:3, 3]))
     c = (np.trace(F[:3, :3].T @ Tm[:3, :3]) - 1) / 2
-    return dp, float(np.arccos(np.clip(c, -1.0, 1.0))), _wrap(best.x, periods)
-
+    return dp, float(np.arccos(np.clip(c, -1.0, 1.0))), best
