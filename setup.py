@@ -8,10 +8,24 @@ Flags: ISO C (-std=c11, so no floating-point contraction: the results match the 
 rounding) and -fno-math-errno (libm need not set errno, which lets the compiler fuse sin and cos
 of one angle into sincos; results are unchanged).
 """
+import hashlib
 from glob import glob
+from pathlib import Path
 
 import numpy
 from setuptools import Extension, setup
+
+C_FILES = sorted(glob("generated/c/*.c") + glob("generated/c/*.h"))
+
+
+def sources_hash(paths) -> str:
+    """SHA-256 of the C files compiled here, as codegen.emitter.sources_hash computes it for the
+    manifest (file name, NUL, text, NUL, in name order): the runtime compares the two."""
+    h = hashlib.sha256()
+    for p in sorted(paths, key=lambda p: Path(p).name):
+        h.update(Path(p).name.encode() + b"\0" + Path(p).read_bytes() + b"\0")
+    return h.hexdigest()
+
 
 setup(
     ext_modules=[
@@ -22,6 +36,7 @@ setup(
             include_dirs=["generated/c", numpy.get_include()],
             extra_compile_args=["-std=c11", "-O2", "-fno-math-errno"],
             libraries=["m"],
+            define_macros=[("APAIR_SOURCES_HASH", f'"{sources_hash(C_FILES)}"')],
             optional=True,
         )
     ]

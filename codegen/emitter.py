@@ -222,25 +222,30 @@ class Emitter:
         header_t, header_src = self._template("apair.h.j2")
         src_t, src_src = self._template("kernels.c.j2")
         py_t, py_src = self._template("kernels.py.j2")
-        header_hash = content_hash([header_src, VERSION] + [fingerprints[k.name] for k in all_kernels])
         sources = sorted({k.spec.source for k in all_kernels})
-        files["c/apair.h"] = header_t.render(kernels=all_kernels, hash=header_hash, sources=sources, prefix=PREFIX,
-                                             version=VERSION)
         registry_t, registry_src = self._template("registry.c.j2")
         files["c/apair_registry.c"] = registry_t.render(
             kernels=sorted(all_kernels, key=lambda k: k.name), prefix=PREFIX, sources=sources,
             hash=content_hash([registry_src] + [fingerprints[k.name] for k in all_kernels]))
+        for stem, ks in lowered.items():
+            c_hash = content_hash([src_src] + [fingerprints[k.name] for k in ks])
+            files[f"c/{stem}.c"] = src_t.render(kernels=ks, source=ks[0].spec.source, hash=c_hash, prefix=PREFIX)
         c_sources = sorted(["apair_registry.c"] + [f"{stem}.c" for stem in lowered])
+        # the header's hash covers every C source the binding compiles (so their templates too)
+        header_hash = content_hash([header_src, VERSION] + [fingerprints[k.name] for k in all_kernels]
+                                   + [files[f"c/{c}"] for c in c_sources])
+        files["c/apair.h"] = header_t.render(kernels=all_kernels, hash=header_hash, sources=sources, prefix=PREFIX,
+                                             version=VERSION)
         for name in ("CMakeLists.txt", "apair.pc.in"):
             t, src = self._template(f"{name}.j2")
             files[f"c/{name}"] = t.render(sources=sources, c_sources=c_sources, version=VERSION,
                                           hash=content_hash([src, VERSION] + c_sources))
-        manifest = {"content_hash": header_hash, "prefix": PREFIX, "kernels": {}}
+        manifest = {"content_hash": header_hash, "prefix": PREFIX, "kernels": {},
+                    "sources_hash": sources_hash({rel[2:]: text for rel, text in files.items()
+                                                  if rel.startswith("c/") and rel.endswith((".c", ".h"))})}
         for stem, ks in lowered.items():
             source = ks[0].spec.source
-            c_hash = content_hash([src_src] + [fingerprints[k.name] for k in ks])
             py_hash = content_hash([py_src] + [fingerprints[k.name] for k in ks])
-            files[f"c/{stem}.c"] = src_t.render(kernels=ks, source=source, hash=c_hash, prefix=PREFIX)
             files[f"numpy/{stem}.py"] = py_t.render(kernels=ks, source=source, hash=py_hash)
             for k in ks:
                 manifest["kernels"][k.name] = {
@@ -276,6 +281,16 @@ def content_hash(parts: list[str]) -> str:
         h.update(p.encode())
         h.update(b"\0")
     return h.hexdigest()[:16]
+
+
+def sources_hash(texts: dict[str, str]) -> str:
+    """SHA-256 of the C files the binding compiles ({file name: text}, in name order). setup.py
+    computes the same digest of the files it actually compiles and builds it into apair._native,
+    so the runtime notices a build from other sources than the manifest's (even a hand edit)."""
+    h = hashlib.sha256()
+    for name in sorted(texts):
+        h.update(name.encode() + b"\0" + texts[name].encode() + b"\0")
+    return h.hexdigest()
 
 
 def write(files: dict[str, str], out: Path, clean: bool = True, keep: tuple[str, ...] = ()) -> list[str]:

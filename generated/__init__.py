@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 7fb7fe1823892faf
+Content hash: 3bdfd61232df863f
 """

@@ -145,7 +145,7 @@ def test_bad_chain_file(capsys, tmp_path):
     path.write_text('[[joint]]\npair = "helical"\na = 0.1\nalpha = 0\n')
     code, out, err = run(capsys, "fk", path, "0.1")
     assert code == 2 and out == ""
-    assert "joint[0].pair" in err and "helical" in err
+    assert "joint 1.pair" in err and "helical" in err
 
 
 def test_module_entry_point():

@@ -77,7 +77,7 @@ def test_limits_agree_with_a_dense_scan(kind):
             legs, plate = C.clearances(pair, np.array(value))
             assert min(legs.min(), plate) == pytest.approx(0.0, abs=1e-12)
         if lim.what.startswith("legs"):
-            i, j = map(int, lim.what.split()[1::2])
+            i, j = (int(k) - 1 for k in lim.what.split()[1::2])  # legs are numbered from 1
             th = lim.theta_max if lim.theta_max <= -lim.theta_min else lim.theta_min
             pts = pair.leg_endpoints(th)
             gap = C.segment_distance(pts[i, 0], pts[i, 1], pts[j, 0], pts[j, 1])

@@ -310,23 +310,23 @@ GOOD = joints(SIN + "a = 0.3\nalpha_deg = 90\noffset = 0.1\n", GEN + "a = 0.25\n
 @pytest.mark.parametrize("text, match", [
     ("[[joint]\n", r"is not valid TOML"),
     ('name = "x"\nfoo = 1\n' + GOOD, r"unknown keys \['foo'\]"),
-    (joints('pair = "helical"\na = 0.1\nalpha = 0\n'), r"joint\[0\]\.pair: .*'helical'"),
-    (joints("a = 0.1\nalpha = 0\n"), r"joint\[0\]\.pair: .*None"),
-    (joints('pair = "revolute"\nbase_radius = 0.05\na = 0.1\nalpha = 0\n'), r"joint\[0\]: keys \['base_radius'\] are not valid for a revolute"),
-    (joints('pair = "sinusoidal"\nbase_radius = 0.05\na = 0.1\nalpha = 0\n'), r"joint\[0\]: missing platform_radius"),
-    (joints('pair = "general"\nbase_radius = 0.05\nplatform_radius = 0.04\na = 0.1\nalpha = 0\n'), r"joint\[0\]: missing leg_length"),
-    (joints(SIN + "leg_length = 0.09\na = 0.1\nalpha = 0\n"), r"joint\[0\]: keys \['leg_length'\]"),
-    (joints(SIN + "a = 0.1\nalpha = 0\nalpha_deg = 0\n"), r"joint\[0\]: give alpha or alpha_deg, not both"),
+    (joints('pair = "helical"\na = 0.1\nalpha = 0\n'), r"joint 1\.pair: .*'helical'"),
+    (joints("a = 0.1\nalpha = 0\n"), r"joint 1\.pair: .*None"),
+    (joints('pair = "revolute"\nbase_radius = 0.05\na = 0.1\nalpha = 0\n'), r"joint 1: keys \['base_radius'\] are not valid for a revolute"),
+    (joints('pair = "sinusoidal"\nbase_radius = 0.05\na = 0.1\nalpha = 0\n'), r"joint 1: missing platform_radius"),
+    (joints('pair = "general"\nbase_radius = 0.05\nplatform_radius = 0.04\na = 0.1\nalpha = 0\n'), r"joint 1: missing leg_length"),
+    (joints(SIN + "leg_length = 0.09\na = 0.1\nalpha = 0\n"), r"joint 1: keys \['leg_length'\]"),
+    (joints(SIN + "a = 0.1\nalpha = 0\nalpha_deg = 0\n"), r"joint 1: give alpha or alpha_deg, not both"),
     (joints(SIN + "a = 0.1\nalpha = 0\ntheta_offset = 0\ntheta_offset_deg = 0\n"), r"give theta_offset or theta_offset_deg"),
-    (joints(SIN + 'a = "x"\nalpha = 0\n'), r"joint\[0\]\.a: expected a number, got 'x'"),
-    (joints(SIN + "a = true\nalpha = 0\n"), r"joint\[0\]\.a: expected a number"),
-    (joints(SIN + 'a = 0.1\nalpha_deg = "90"\n'), r"joint\[0\]\.alpha_deg: expected a number"),
-    (joints(SIN + "a = 0.1\nalpha = 0\noffset = [1]\n"), r"joint\[0\]\.offset: expected a number"),
-    (joints('pair = "sinusoidal"\nbase_radius = "big"\nplatform_radius = 0.04\na = 0.1\nalpha = 0\n'), r"joint\[0\]\.base_radius: expected a number"),
-    (joints(SIN + "alpha = 0\n"), r"joint\[0\]: missing a$"),
-    (joints(SIN + "a = 0.1\n"), r"joint\[0\]: missing alpha"),
-    (joints(SIN.replace("0.05", "-0.05") + "a = 0.1\nalpha = 0\n"), r"joint\[0\]\.base_radius: must be > 0"),
-    (joints(GEN.replace("0.09", "0.001") + "a = 0.1\nalpha = 0\n"), r"joint\[0\]\.leg_length: .*no real pose"),
+    (joints(SIN + 'a = "x"\nalpha = 0\n'), r"joint 1\.a: expected a number, got 'x'"),
+    (joints(SIN + "a = true\nalpha = 0\n"), r"joint 1\.a: expected a number"),
+    (joints(SIN + 'a = 0.1\nalpha_deg = "90"\n'), r"joint 1\.alpha_deg: expected a number"),
+    (joints(SIN + "a = 0.1\nalpha = 0\noffset = [1]\n"), r"joint 1\.offset: expected a number"),
+    (joints('pair = "sinusoidal"\nbase_radius = "big"\nplatform_radius = 0.04\na = 0.1\nalpha = 0\n'), r"joint 1\.base_radius: expected a number"),
+    (joints(SIN + "alpha = 0\n"), r"joint 1: missing a$"),
+    (joints(SIN + "a = 0.1\n"), r"joint 1: missing alpha"),
+    (joints(SIN.replace("0.05", "-0.05") + "a = 0.1\nalpha = 0\n"), r"joint 1\.base_radius: must be > 0"),
+    (joints(GEN.replace("0.09", "0.001") + "a = 0.1\nalpha = 0\n"), r"joint 1\.leg_length: .*no real pose"),
     (joints(SIN + "a = nan\nalpha = 0\n"), r"a: contains NaN"),
     (joints(SIN + "a = 0.1\nalpha = inf\n"), r"alpha: contains NaN or infinite"),
     ('name = "empty"\n', r"needs at least one \[\[joint\]\]"),
@@ -352,7 +352,7 @@ def test_load_missing_file(tmp_path):
 def test_load_joint_not_a_table(tmp_path, text):
     path = tmp_path / "chain.toml"
     path.write_text(text)
-    with pytest.raises(ValueError, match=r"joint\[0\]"):
+    with pytest.raises(ValueError, match=r"joint 1"):
         apair.load(path)
 
 

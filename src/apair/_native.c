@@ -2,8 +2,8 @@
  * apair._native: the Python binding of the generated C kernels (generated/c), generic over the
  * kernel registry (apair_kernels), so nothing here is written per kernel.
  *
- * call(index, *inputs) evaluates registry kernel `index` on float64 C-contiguous NumPy arrays
- * whose trailing dimensions are the kernel's argument shapes. Leading (batch) dimensions must be
+ * call(index, *inputs) evaluates registry kernel `index` on float64 C-contiguous, aligned NumPy
+ * arrays in native byte order * whose trailing dimensions are the kernel's argument shapes. Leading (batch) dimensions must be
  * the same for every input that has them; an input without them is shared by the whole batch
  * (stride 0). Returns the list of output arrays, or None when some input is not in that canonical
  * form: the caller (apair.kernels) then converts and broadcasts, and calls again. That keeps the
@@ -16,6 +16,10 @@
 #include <numpy/arrayobject.h>
 
 #include "apair.h"
+
+#ifndef APAIR_SOURCES_HASH /* set by setup.py: the SHA-256 of the generated C files compiled */
+#error "APAIR_SOURCES_HASH must be defined (build with setup.py)"
+#endif
 
 #define MAX_ARGS 16
 #define MAX_DIMS NPY_MAXDIMS
@@ -66,7 +70,8 @@ static PyObject *native_call(PyObject *self, PyObject *const *args, Py_ssize_t n
         a = (PyArrayObject *)args[i + 1];
         nd = PyArray_NDIM(a);
         extra = nd - spec->rank;
-        if (PyArray_TYPE(a) != NPY_DOUBLE || !PyArray_IS_C_CONTIGUOUS(a) || !PyArray_ISALIGNED(a) || extra < 0) {
+        if (PyArray_TYPE(a) != NPY_DOUBLE || !PyArray_ISNOTSWAPPED(a) || !PyArray_IS_C_CONTIGUOUS(a) ||
+            !PyArray_ISALIGNED(a) || extra < 0) {
             Py_RETURN_NONE;
         }
         for (d = 0; d < spec->rank; ++d) {
@@ -178,7 +183,8 @@ PyMODINIT_FUNC PyInit__native(void)
     if (m == NULL) {
         return NULL;
     }
-    if (PyModule_AddStringConstant(m, "content_hash", APAIR_CONTENT_HASH) < 0) {
+    if (PyModule_AddStringConstant(m, "content_hash", APAIR_CONTENT_HASH) < 0 ||
+        PyModule_AddStringConstant(m, "sources_hash", APAIR_SOURCES_HASH) < 0) {
         Py_DECREF(m);
         return NULL;
     }

@@ -80,6 +80,10 @@ class AChain:
             lo, hi = V.vector(f"limits[{i}]", lim, 2)
             if not lo < hi:
                 raise ValueError(f"limits[{i}]: expected lo < hi, got ({lo}, {hi})")
+            plo, phi = self.pairs[i].motion_range()
+            if lo < plo or hi > phi:
+                raise ValueError(f"limits[{i}]: ({lo:.6g}, {hi:.6g}) rad goes beyond joint {i + 1}'s collision-free "
+                                 f"range ({plo:.6g}, {phi:.6g}) rad")
             out.append((float(lo), float(hi)))
         return out
 
@@ -87,20 +91,17 @@ class AChain:
     def limits(self) -> np.ndarray:
         """(n, 2): each joint's range [rad]: the explicit one if given, else the pair's collision
         limits (`APair.collision_limits`), within its range of motion; a free joint gets one turn
-        (−π, π). An explicit range beyond the collision-free one is refused here."""
+        (−π, π)."""
+        out = self.hard_limits()
+        out[~np.isfinite(out).all(axis=1)] = -math.pi, math.pi
+        return out
+
+    def hard_limits(self) -> np.ndarray:
+        """(n, 2): the ranges that physically stop each joint (explicit, collision limits, range
+        ends), ±inf for a joint that turns freely (as `simulate` uses them)."""
         out = np.empty((self.n, 2))
-        for i, (p, lim) in enumerate(zip(self.pairs, self._explicit_limits)):
-            lo, hi, _ = p.collision_limits()
-            if p.theta_limit is not None:
-                lo, hi = max(lo, -p.theta_limit), min(hi, p.theta_limit)
-            if not (math.isfinite(lo) and math.isfinite(hi)):
-                lo, hi = -math.pi, math.pi
-            if lim is not None:
-                if lim[0] < lo or lim[1] > hi:
-                    raise ValueError(f"limits[{i}]: ({lim[0]:.6g}, {lim[1]:.6g}) goes beyond the pair's "
-                                     f"collision-free range ({lo:.6g}, {hi:.6g})")
-                lo, hi = lim
-            out[i] = lo, hi
+        for i, lim in enumerate(self._explicit_limits):
+            out[i] = lim if lim is not None else self.pairs[i].motion_range()
         return out
 
     @property
@@ -216,16 +217,19 @@ class AChain:
         (q, qd), law = self._state(q, qd=qd)
         return call(f"energy{self.n}", q, qd, self._dh, law, self._links, self._legs, self.gravity)[0]
 
-    def simulate(self, q0, qd0, t, tau=None, rtol=1e-10, atol=1e-12, method="DOP853"):
+    def simulate(self, q0, qd0, t, tau=None, rtol=1e-10, atol=1e-12, method="DOP853", limits="stop"):
         """Integrate the equations of motion from (q0, qd0) and report the state at times `t`.
 
         tau: None (free motion), an array (n,), or a callable tau(t, q, qd) -> (n,).
         Adaptive Runge-Kutta (scipy.integrate.solve_ivp) over the generated kernels.
-        Returns a `Trajectory` with t, q, qd, and the energies T, V along it.
+        limits: "stop" ends the run where a joint first reaches a limit of `hard_limits` (the
+        event's state is the last sample; `Trajectory.stop` says which joint, which side, when);
+        "ignore" passes through explicit and collision limits (range ends still stop it).
+        Returns a `Trajectory` with t, q, qd, the energies T, V along it, and `stop`.
         """
         from .simulate import simulate
 
-        return simulate(self, q0, qd0, t, tau, rtol=rtol, atol=atol, method=method)
+        return simulate(self, q0, qd0, t, tau, rtol=rtol, atol=atol, method=method, limits=limits)
 
     # ----------------------------------------------------------------------------- varieties
     def constraint_variety(self, max_degree: int = 4, seed: int = 0):

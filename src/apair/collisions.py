@@ -151,7 +151,10 @@ def real_roots_t(poly) -> list[float]:
 
 
 def segment_distance(P0, P1, Q0, Q1) -> np.ndarray:
-    """Distance between segments P0P1 and Q0Q1, broadcasting over leading axes (…, 3)."""
+    """Distance between segments P0P1 and Q0Q1, broadcasting over leading axes (…, 3); computed
+    in units of the largest coordinate, so that no product over- or underflows at any scale."""
+    unit = max(float(np.abs(x).max(initial=0.0)) for x in (P0, P1, Q0, Q1)) or 1.0
+    P0, P1, Q0, Q1 = (np.asarray(x) / unit for x in (P0, P1, Q0, Q1))
     u, v, w = P1 - P0, Q1 - Q0, P0 - Q0
     a, b, c = np.sum(u * u, -1), np.sum(u * v, -1), np.sum(v * v, -1)
     d, e = np.sum(u * w, -1), np.sum(v * w, -1)
@@ -162,7 +165,7 @@ def segment_distance(P0, P1, Q0, Q1) -> np.ndarray:
         s = np.where(t < 0, np.clip(-d / a, 0.0, 1.0), np.where(t > 1, np.clip((b - d) / a, 0.0, 1.0), s))
         t = np.clip(t, 0.0, 1.0)
     gap = w + s[..., None] * u - t[..., None] * v
-    return np.linalg.norm(gap, axis=-1)
+    return unit * np.linalg.norm(gap, axis=-1)
 
 
 def clearances(pair, theta) -> tuple[np.ndarray, np.ndarray]:
@@ -174,30 +177,54 @@ def clearances(pair, theta) -> tuple[np.ndarray, np.ndarray]:
     return dist - 2 * pair.leg_radius, pair.translation(theta) - pair.thickness
 
 
+def _rational(x: float) -> Fraction:
+    """x (in units of the pair's size) as a rational within 1e-12·size: exact enough for a touch
+    tolerance of 1e-9·size, and free of the huge denominators that tiny doubles (a leg radius of
+    1e-300) would carry into the polynomials."""
+    return Fraction(x).limit_denominator(10**12)
+
+
+def unit_pair(pair):
+    """The same pair in units of its size r_b + r_p (collision angles do not depend on scale)."""
+    from .pair import APair
+
+    s = pair.base_radius + pair.platform_radius
+    L1 = None if pair.kind == "sinusoidal" else pair.leg_lengths[0] / s
+    return APair(pair.base_radius / s, pair.platform_radius / s, leg_length=L1, leg_radius=pair.leg_radius / s,
+                 thickness=pair.thickness / s)
+
+
 def limits(pair) -> CollisionLimits:
-    """The collision-free interval around θ = 0 (see the module docstring)."""
+    """The collision-free interval around θ = 0 (see the module docstring), computed on the pair
+    in units of its size, so that the answer is the same at every scale."""
     if pair.kind == "revolute":
         return CollisionLimits(-math.inf, math.inf, "none")
     size = pair.base_radius + pair.platform_radius
     legs0, plate0 = clearances(pair, np.array(0.0))
     if legs0.min() <= 0:
         i, j = LEG_PAIRS[int(np.argmin(legs0))]
-        raise ValueError(f"leg_radius: {pair.leg_radius} is too large, legs {i} and {j} overlap at theta = 0 "
+        raise ValueError(f"leg_radius: {pair.leg_radius} is too large, legs {i + 1} and {j + 1} overlap at theta = 0 "
                          f"(the pair cannot move); the largest radius is {(legs0.min() + 2 * pair.leg_radius) / 2:.6g}")
     if plate0 <= 0:
         raise ValueError(f"thickness: {pair.thickness} is not less than d(0) = {pair.translation(0.0):.6g}, "
                          f"the plates overlap at theta = 0 (the pair cannot move)")
+    end = pair.theta_limit  # the range end of the pair itself (the unit pair's differs by rounding)
+    pair, size = unit_pair(pair), 1.0
+    r_b, r_p = _rational(pair.base_radius), _rational(pair.platform_radius)
     if pair.kind == "sinusoidal":  # d² = a + b cos θ with a = b = r_b r_p, exactly
-        a = b = Fraction(pair.base_radius) * Fraction(pair.platform_radius)
+        a = b = r_b * r_p
     else:  # the design kernel's constants, as the runtime's d(θ) uses them
-        a, b = pair.a, pair.b
+        a, b = _rational(pair.a), _rational(pair.b)
     candidates = set()
-    for _, poly in contact_polynomials(pair.base_radius, pair.platform_radius, a, b, 2 * pair.leg_radius, pair.thickness):
+    for _, poly in contact_polynomials(r_b, r_p, a, b, _rational(2 * pair.leg_radius), _rational(pair.thickness)):
         candidates.update(4 * math.atan(t) for t in real_roots_t(poly))
     lim = pair.theta_limit
     candidates = sorted(th for th in candidates if th != 0 and (lim is None or abs(th) <= lim))
     upper = _first_touch([th for th in candidates if th > 0], pair, size)
     lower = _first_touch(sorted((th for th in candidates if th < 0), reverse=True), pair, size)
+    if end is not None:  # a general pair with a < b: its motion ends at d = 0, the plates coplanar
+        upper = (min(upper[0], end), upper[1]) if upper else (end, "plates")
+        lower = (max(lower[0], -end), lower[1]) if lower else (-end, "plates")
     if upper is None and lower is None:
         return CollisionLimits(-math.inf, math.inf, "none")
     theta_max, what_max = upper if upper is not None else (math.inf, "none")
@@ -215,7 +242,7 @@ def _first_touch(ordered, pair, size):
         if min(legs[k], plate) < -_TOUCH_RTOL * size:
             raise RuntimeError(f"collision limits: overlap at theta = {th!r} with no touch before it")
         if abs(legs[k]) <= _TOUCH_RTOL * size:
-            return th, "legs {} and {}".format(*LEG_PAIRS[k])
+            return th, "legs {} and {}".format(*(i + 1 for i in LEG_PAIRS[k]))
         if abs(plate) <= _TOUCH_RTOL * size:
             return th, "plates"
     return None

@@ -76,13 +76,21 @@ def _angle(where: str, j: dict, key: str, default=None):
     return default
 
 
-def _limits(where: str, j: dict):
-    """A joint's explicit (lo, hi) in radians, or None."""
+def _limits(where: str, j: dict, pair: APair):
+    """A joint's explicit (lo, hi) in radians, or None; checked against the pair's collision-free
+    range here, so that the message uses the file's key and units."""
     if "limits" in j and "limits_deg" in j:
         raise ValueError(f"{where}: give limits or limits_deg, not both")
-    for key, scale in (("limits", 1.0), ("limits_deg", math.pi / 180)):
+    for key, unit, scale in (("limits", "rad", 1.0), ("limits_deg", "deg", math.pi / 180)):
         if key in j:
-            return tuple(_numbers(f"{where}.{key}", j[key], [(2,)]) * scale)
+            lo, hi = _numbers(f"{where}.{key}", j[key], [(2,)])
+            if not lo < hi:
+                raise ValueError(f"{where}.{key}: expected lo < hi, got ({lo:g}, {hi:g}) {unit}")
+            plo, phi = pair.motion_range()
+            if lo * scale < plo or hi * scale > phi:
+                raise ValueError(f"{where}.{key}: ({lo:g}, {hi:g}) {unit} goes beyond the pair's collision-free "
+                                 f"range ({plo / scale:.6g}, {phi / scale:.6g}) {unit}")
+            return lo * scale, hi * scale
     return None
 
 
@@ -102,7 +110,7 @@ def chain_from_dict(data: dict, where: str = "chain") -> AChain:
         raise ValueError(f"{where}: needs at least one [[joint]] table")
     pairs, a, alpha, offset, theta_offset, links, limits = [], [], [], [], [], [], []
     for i, j in enumerate(joints):
-        w = f"{where}: joint[{i}]"
+        w = f"{where}: joint {i + 1}"
         if not isinstance(j, dict):
             raise ValueError(f"{w}: expected a [[joint]] table, got {j!r}")
         kind = j.get("pair")
@@ -130,7 +138,7 @@ def chain_from_dict(data: dict, where: str = "chain") -> AChain:
         offset.append(_number(f"{w}.offset", j.get("offset", 0.0)))
         theta_offset.append(_angle(w, j, "theta_offset", 0.0))
         links.append(_link(w, j))
-        limits.append(_limits(w, j))
+        limits.append(_limits(w, j, pairs[-1]))
     gravity = _numbers(f"{where}: gravity", data.get("gravity", [0.0, 0.0, -9.81]), [(3,)])
     try:
         return AChain(pairs, a, alpha, offset, theta_offset, links=links, gravity=gravity, limits=limits)

@@ -35,9 +35,10 @@ def _native():
         module = importlib.import_module("apair._native")
     except ImportError as exc:
         return None, f"the compiled C kernels (apair._native) are not installed ({exc})"
-    if module.content_hash != manifest()["content_hash"]:
+    m = manifest()
+    if module.content_hash != m["content_hash"] or getattr(module, "sources_hash", None) != m["sources_hash"]:
         return None, (f"the compiled C kernels (apair._native, {module.content_hash}) were built from other "
-                      f"generated code than the manifest ({manifest()['content_hash']}): reinstall apair")
+                      f"generated C sources than the manifest's ({m['content_hash']}): reinstall apair")
     return module, None
 
 
@@ -81,15 +82,17 @@ def _resolve_backend() -> str:
     return "numpy"
 
 
-_c_indices: dict[str, int] = {}
+@lru_cache(maxsize=None)
+def _c_table(native) -> dict[str, int]:
+    """Kernel name → registry index of the extension module, built whole before it is returned
+    (threads calling for the first time never see a half-filled table)."""
+    return {n: i for i, n in enumerate(native.names())}
 
 
 def _c_index(native, name: str) -> int:
     """The registry index of kernel `name` in the extension module."""
-    if not _c_indices:
-        _c_indices.update((n, i) for i, n in enumerate(native.names()))
     try:
-        return _c_indices[name]
+        return _c_table(native)[name]
     except KeyError:
         raise ValueError(f"kernel: no generated kernel called {name!r}") from None
 
@@ -102,18 +105,34 @@ def _numpy_function(name: str):
 
 
 def _canonical(name: str, inputs) -> list[np.ndarray]:
-    """The inputs as float64 C-contiguous arrays with one common batch shape (or none)."""
-    spec = manifest()["kernels"][name]["inputs"]
-    if len(inputs) != len(spec):
-        raise TypeError(f"{name}: expected {len(spec)} inputs, got {len(inputs)}")
-    arrays = [np.asarray(x, dtype=np.float64) for x in inputs]
+    """The inputs as float64 arrays (native byte order, aligned, C-contiguous) with one common
+    batch shape (or none)."""
+    spec = _input_spec(name, inputs)
+    arrays = [_float64(name, a["name"], x) for x, a in zip(inputs, spec)]
     shapes = [tuple(a["shape"]) for a in spec]
     for x, s, a in zip(arrays, shapes, spec):
         if x.ndim < len(s) or x.shape[x.ndim - len(s):] != s:
             raise ValueError(f"{name}: input {a['name']} must end in shape {s}, got {x.shape}")
     batch = np.broadcast_shapes(*(x.shape[: x.ndim - len(s)] for x, s in zip(arrays, shapes)))
-    return [np.ascontiguousarray(x if x.ndim == len(s) else np.broadcast_to(x, batch + s))
+    return [np.require(x if x.ndim == len(s) else np.broadcast_to(x, batch + s), requirements=("C", "A"))
             for x, s in zip(arrays, shapes)]
+
+
+def _input_spec(name: str, inputs) -> list[dict]:
+    """The manifest's input list of kernel `name`, checked against the number of inputs given."""
+    spec = manifest()["kernels"][name]["inputs"]
+    if len(inputs) != len(spec):
+        raise TypeError(f"{name}: expected {len(spec)} inputs, got {len(inputs)}")
+    return spec
+
+
+def _float64(kernel: str, arg: str, x) -> np.ndarray:
+    """x as a native-endian float64 array; complex, boolean or non-numeric input is refused (a
+    silent cast would drop imaginary parts or turn True into 1.0)."""
+    arr = np.asarray(x)
+    if arr.dtype.kind not in "iuf":
+        raise ValueError(f"{kernel}: input {arg} must be real numbers, got dtype {arr.dtype}")
+    return arr.astype(np.float64, copy=False)
 
 
 def call(name: str, *inputs) -> list[np.ndarray]:
@@ -124,7 +143,10 @@ def call(name: str, *inputs) -> list[np.ndarray]:
         out = native.call(index, *inputs)
         if out is None:  # some input needs converting or broadcasting first
             out = native.call(index, *_canonical(name, inputs))
+            if out is None:
+                raise ValueError(f"{name}: the inputs do not fit the kernel's shapes after broadcasting")
         return out
-    inputs = [np.asarray(x, dtype=np.float64) for x in inputs]
+    spec = _input_spec(name, inputs)
+    inputs = [_float64(name, a["name"], x) for x, a in zip(inputs, spec)]
     out = _numpy_function(name)(*inputs)
     return list(out) if isinstance(out, tuple) else [out]

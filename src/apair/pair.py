@@ -16,6 +16,20 @@ KINDS = ("sinusoidal", "general", "revolute")
 _SINUSOIDAL_RTOL = 1e-12  # |a - b| <= this * b: the leg length is the sinusoidal one
 
 
+LENGTH_RANGE = (1e-150, 1e150)  # [m]: lengths whose squares and products are normal doubles
+
+
+def _length(name: str, value, positive: bool = False) -> float:
+    """A length [m] inside LENGTH_RANGE (0 allowed unless positive): outside it the pair's
+    constants (L², r_b·r_p) overflow or underflow and no finite answer exists."""
+    x = V.scalar(name, value, positive=positive, nonnegative=True)
+    lo, hi = LENGTH_RANGE
+    if x > hi or (x != 0 and x < lo):
+        raise ValueError(f"{name}: {x!r} m is outside the range {lo:g} .. {hi:g} m in which the pair's "
+                         "constants (squares and products of lengths) are finite doubles")
+    return x
+
+
 class APair:
     """An A-pair with base/platform circumradii r_b, r_p and leg length L1 (None: sinusoidal).
 
@@ -24,11 +38,11 @@ class APair:
     """
 
     def __init__(self, base_radius, platform_radius, leg_length=None, leg_mass=0.0, leg_radius=0.0, thickness=0.0):
-        r_b = V.scalar("base_radius", base_radius, positive=True)
-        r_p = V.scalar("platform_radius", platform_radius, positive=True)
+        r_b = _length("base_radius", base_radius, positive=True)
+        r_p = _length("platform_radius", platform_radius, positive=True)
         self.leg_mass = V.scalar("leg_mass", leg_mass, nonnegative=True)
-        self.leg_radius = V.scalar("leg_radius", leg_radius, nonnegative=True)
-        self.thickness = V.scalar("thickness", thickness, nonnegative=True)
+        self.leg_radius = _length("leg_radius", leg_radius)
+        self.thickness = _length("thickness", thickness)
         self._limits = None
         self.base_radius, self.platform_radius = r_b, r_p
         radii = np.array([r_b, r_p])
@@ -36,7 +50,7 @@ class APair:
             L1, L2, a, b, h = call("design_sinusoidal", radii)[0]
             self.kind = "sinusoidal"
         else:
-            L1 = V.scalar("leg_length", leg_length, positive=True)
+            L1 = _length("leg_length", leg_length, positive=True)
             L2_sq, a, b, a_plus_b = call("design_general", radii, [L1])[0]
             if not a_plus_b > 0 or not L2_sq > 0:
                 lo = math.sqrt(r_b**2 + r_p**2 / 4 - r_b * r_p) if r_b**2 + r_p**2 / 4 > r_b * r_p else 0.0
@@ -66,8 +80,11 @@ class APair:
     def __repr__(self) -> str:
         if self.kind == "revolute":
             return "APair.revolute()"
-        ll = "" if self.kind == "sinusoidal" else f", leg_length={self._L[0]!r}"
-        return f"APair({self.base_radius!r}, {self.platform_radius!r}{ll})"
+        extra = "" if self.kind == "sinusoidal" else f", leg_length={self._L[0]!r}"
+        for key in ("leg_mass", "leg_radius", "thickness"):  # every parameter off its default
+            if getattr(self, key) != 0.0:
+                extra += f", {key}={getattr(self, key)!r}"
+        return f"APair({self.base_radius!r}, {self.platform_radius!r}{extra})"
 
     @property
     def amplitude(self) -> float:
@@ -85,9 +102,14 @@ class APair:
 
     @property
     def theta_limit(self) -> float | None:
-        """|θ| ≤ arccos(−a/b) for a general pair with a < b; None where θ is unbounded."""
+        """|θ| ≤ arccos(−a/b) for a general pair with a < b (the largest double at which
+        a + b cos θ ≥ 0 still holds in floating point, so d(theta_limit) = 0 is defined); None
+        where θ is unbounded."""
         if self.kind == "general" and self.a < self.b:
-            return math.acos(-self.a / self.b)
+            lim = math.acos(-self.a / self.b)
+            while self.a + self.b * math.cos(lim) < 0:
+                lim = math.nextafter(lim, 0.0)
+            return lim
         return None
 
     def collision_limits(self):
@@ -101,14 +123,29 @@ class APair:
             self._limits = limits(self)
         return self._limits
 
+    def motion_range(self) -> tuple[float, float]:
+        """The collision-free range of θ within the pair's range of motion (±inf where it turns
+        freely): what an explicit joint range may narrow but not exceed."""
+        lo, hi, _ = self.collision_limits()
+        if self.theta_limit is not None:
+            lo, hi = max(lo, -self.theta_limit), min(hi, self.theta_limit)
+        return lo, hi
+
     def _theta(self, theta, name="theta") -> np.ndarray:
+        """θ validated; for a pair with a limited range, angles past the range end by no more than
+        rounding (a + b cos θ ≥ −4ε(|a| + b)) are put on it, anything further is refused."""
         th = V.real_array(name, theta)
         if self.kind == "general" and self.a < self.b:
-            bad = self.a + self.b * np.cos(th) < 0
+            gap = self.a + self.b * np.cos(th)
+            bad = gap < 0
             if np.any(bad):
-                raise ValueError(
-                    f"{name}: outside this pair's range |theta| <= {self.theta_limit:.12g} (mod 2 pi), "
-                    f"e.g. {th[bad].flat[0]!r}")
+                far = gap < -4 * np.finfo(float).eps * (abs(self.a) + self.b)
+                if np.any(far):
+                    raise ValueError(
+                        f"{name}: outside this pair's range |theta| <= {self.theta_limit:.12g} (mod 2 pi), "
+                        f"e.g. {th[far].flat[0]!r}")
+                turns = 2 * np.pi * np.round(th / (2 * np.pi))
+                th = np.where(bad, turns + np.copysign(self.theta_limit, th - turns), th)
         return th
 
     def law(self, theta, name="theta") -> np.ndarray:

@@ -1,4 +1,13 @@
-"""Time integration of a chain's equations of motion over the generated kernels."""
+"""Time integration of a chain's equations of motion over the generated kernels.
+
+Joint limits are events: with limits="stop" (the default) the integration ends where a joint
+first reaches one of its hard limits (`AChain.hard_limits`: explicit, collision or range end),
+located to the integrator's tolerance; the trajectory up to there is returned, the state at the
+event as its last sample, and `Trajectory.stop` says which joint hit which limit when. With
+limits="ignore" the joints pass through explicit and collision limits (the legs are taken to pass
+through each other), and only the end of a general pair's range of motion (d = 0, where the motion
+itself ends) stops the run.
+"""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -6,6 +15,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _validate as V
+
+
+@dataclass(frozen=True)
+class LimitStop:
+    """Where a run ended: joint (1-based) reached its `side` ("lower" or "upper") limit `value`
+    [rad] at time t [s]."""
+
+    joint: int
+    side: str
+    value: float
+    t: float
+
+    def __str__(self) -> str:
+        return f"joint {self.joint} reached its {self.side} limit {self.value:.6g} rad at t = {self.t:.6g} s"
 
 
 @dataclass
@@ -17,13 +40,14 @@ class Trajectory:
     qd: np.ndarray
     kinetic: np.ndarray
     potential: np.ndarray
+    stop: LimitStop | None = None  # the joint limit that ended the run, None if it ran to t[-1]
 
     @property
     def energy(self) -> np.ndarray:
         return self.kinetic + self.potential
 
 
-def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP853") -> Trajectory:
+def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP853", limits="stop") -> Trajectory:
     from scipy.integrate import solve_ivp
 
     n = chain.n
@@ -36,6 +60,13 @@ def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP
         raise ValueError("t: output times must increase strictly")
     V.scalar("rtol", rtol, positive=True)
     V.scalar("atol", atol, positive=True)
+    if limits not in ("stop", "ignore"):
+        raise ValueError(f"limits: expected 'stop' or 'ignore', got {limits!r}")
+    bounds = _bounds(chain, limits)
+    for i, (lo, hi) in enumerate(bounds):
+        if not lo <= q0[i] <= hi:
+            raise ValueError(f"q0: joint {i + 1} at {q0[i]:.6g} rad is outside its limits ({lo:.6g}, {hi:.6g}) rad"
+                             + (" (limits='ignore' passes explicit and collision limits)" if limits == "stop" else ""))
     if tau is None:
         torque = lambda _t, _q, _qd: np.zeros(n)
     elif callable(tau):
@@ -47,14 +78,53 @@ def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP
     else:
         const = V.vector("tau", tau, n)
         torque = lambda _t, _q, _qd: const
+    # a trial stage of the integrator may look past a range end before the event is located:
+    # the law is evaluated just inside it there (the stage is then rejected or the event found)
+    inside = bounds.copy()
+    ends = [i for i, p in enumerate(chain.pairs) if p.theta_limit is not None]
+    for i in ends:
+        lim = chain.pairs[i].theta_limit * (1 - 1e-9)
+        inside[i] = max(inside[i, 0], -lim), min(inside[i, 1], lim)
 
     def rhs(tt, y):
         q, qd = y[:n], y[n:]
-        return np.concatenate([qd, chain.forward_dynamics(q, qd, torque(tt, q, qd))])
+        if ends:
+            q = q.copy()
+            q[ends] = np.clip(q[ends], inside[ends, 0], inside[ends, 1])
+        return np.concatenate([qd, chain.forward_dynamics(q, qd, torque(tt, y[:n], qd))])
 
-    sol = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([q0, qd0]), method=method, t_eval=t, rtol=rtol, atol=atol)
-    if not sol.success:
+    events, which = [], []
+    for i, (lo, hi) in enumerate(inside):
+        for side, value, sign in (("lower", lo, 1.0), ("upper", hi, -1.0)):
+            if np.isfinite(value):
+                def event(_t, y, i=i, value=value, sign=sign):
+                    return sign * (y[i] - value)
+                event.terminal, event.direction = True, -1
+                events.append(event)
+                which.append((i, side, bounds[i, 0 if side == "lower" else 1]))
+    sol = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([q0, qd0]), method=method, t_eval=t, rtol=rtol, atol=atol,
+                    events=events or None)
+    if sol.status == -1:
         raise ValueError(f"t: the integration failed: {sol.message}")
-    q, qd = sol.y[:n].T, sol.y[n:].T
-    E = chain.energy(q, qd)
-    return Trajectory(t=sol.t, q=q, qd=qd, kinetic=E[:, 0], potential=E[:, 1])
+    times, Y, stop = sol.t, sol.y, None
+    if sol.status == 1:  # a limit event ended the run: its state is the last sample
+        k = next(k for k, te in enumerate(sol.t_events) if len(te))
+        i, side, value = which[k]
+        te, ye = sol.t_events[k][0], sol.y_events[k][0]
+        stop = LimitStop(i + 1, side, float(value), float(te))
+        keep = times < te
+        times, Y = np.append(times[keep], te), np.concatenate([Y[:, keep], ye[:, None]], axis=1)
+    q, qd = Y[:n].T, Y[n:].T
+    E = chain.energy(np.clip(q, inside[:, 0], inside[:, 1]) if ends else q, qd)
+    return Trajectory(t=times, q=q, qd=qd, kinetic=E[:, 0], potential=E[:, 1], stop=stop)
+
+
+def _bounds(chain, limits: str) -> np.ndarray:
+    """(n, 2) the limits that stop a run: all hard limits, or only the range ends of general pairs."""
+    if limits == "stop":
+        return chain.hard_limits()
+    out = np.tile([-np.inf, np.inf], (chain.n, 1))
+    for i, p in enumerate(chain.pairs):
+        if p.theta_limit is not None:
+            out[i] = -p.theta_limit, p.theta_limit
+    return out
