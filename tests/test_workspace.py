@@ -124,3 +124,72 @@ def test_cli_workspace(tmp_path, capsys):
     assert "workspace volume" in cap.out and "batches" in cap.err and out.stat().st_size > 1000
     assert main(["workspace", str(f), "--samples", "8000", "--plot", str(out)]) == 2
     assert "exists" in capsys.readouterr().err
+
+
+# ----------------------------------------------------------------------------- curves and surfaces
+REV = apair.APair.revolute()
+
+
+@pytest.mark.parametrize("chain, dimension, exact", [
+    (apair.AChain([REV], [0.3], [0.0]), 1, 2 * np.pi * 0.3),                              # a circle
+    (apair.AChain([REV, REV], [0.3, 0.1], [0.0, 0.0]), 2, np.pi * (0.4**2 - 0.2**2)),        # a planar annulus
+    (apair.AChain([REV, REV], [0.0, 0.3], [np.pi / 2, 0.0]), 2, 4 * np.pi * 0.3**2),          # a sphere
+    (apair.AChain([REV, REV], [0.3, 0.0], [np.pi / 2, 0.0]), 1, 2 * np.pi * 0.3),            # joint 2 moves nothing
+])
+def test_curves_and_surfaces_report_dimension_and_measure_not_a_volume(chain, dimension, exact):
+    ws = chain.workspace(samples=120_000 if dimension == 2 else 12_000, seed=3)
+    assert ws.dimension == dimension and ws.volume is None and ws.volume_error is None
+    assert abs(ws.measure - exact) <= 0.06 * exact
+    assert ("curve" if dimension == 1 else "surface") in ws.summary and "volume" in ws.summary
+
+
+def test_cli_workspace_of_a_one_joint_chain(tmp_path, capsys):
+    f = tmp_path / "one.toml"
+    f.write_text('[[joint]]\npair = "revolute"\na = 0.3\nalpha = 0\n')
+    assert main(["workspace", str(f), "--samples", "8000", "--quiet", "--plot", str(tmp_path / "w.png")]) == 0
+    out = capsys.readouterr().out
+    assert "a curve (dimension 1, no volume)" in out and "length" in out
+
+
+def test_every_cross_section_shows_its_boundary_voxels():
+    from apair.plots import section
+
+    for chain in (arm(0.3, 0.2), apair.load(EXAMPLES / "4a_chain.toml")):
+        ws = chain.workspace(samples=20_000, resolution=12)
+        for axis in range(3):
+            layer, slab, edge = section(ws, axis)
+            assert edge.sum() > 0 and slab.sum() > 0, axis
+
+
+def test_chain_picture_is_fit_for_a_paper(tmp_path, monkeypatch):
+    """Equal aspect, labelled axes with units, base and end effector marked, filled plates, legs as
+    wide as their radius."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from apair import plots
+
+    captured = {}
+    monkeypatch.setattr(plt, "close", lambda fig: captured.setdefault("fig", fig))
+    thick = apair.APair(0.05, 0.04, leg_radius=0.003)
+    chain = apair.AChain([thick, apair.APair(0.05, 0.04)], [0.1, 0.1], [np.pi / 2, 0.0])
+    plots.chain_picture(chain, [0.3, 0.2], tmp_path / "c.png")
+    ax = captured["fig"].axes[0]
+    assert ax.get_box_aspect() is not None and np.allclose(ax.get_box_aspect() / ax.get_box_aspect()[0], 1)
+    spans = [np.ptp(lim) for lim in (ax.get_xlim(), ax.get_ylim(), ax.get_zlim())]
+    assert np.allclose(spans, spans[0])
+    assert [ax.get_xlabel(), ax.get_ylabel(), ax.get_zlabel()] == ["x [m]", "y [m]", "z [m]"]
+    assert {t.get_text() for t in ax.get_legend().get_texts()} >= {"base", "end effector"}
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    plates = [c for c in ax.collections if isinstance(c, Poly3DCollection)]
+    assert len(plates) == 1 and len(plates[0].get_paths()) == 4  # two pairs, two plates each
+    widths = sorted({round(line.get_linewidth(), 3) for line in ax.lines if line.get_color() == "C0"})
+    assert len(widths) == 2 and widths[-1] > 2 * widths[0]  # the thick legs drawn thicker
+
+
+def test_repr_in_plot_titles_shows_the_leg_data():
+    p = apair.APair(0.05, 0.04, leg_radius=0.002)
+    assert "leg_radius=0.002" in repr(p)

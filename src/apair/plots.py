@@ -5,6 +5,9 @@ Every function writes a new file and refuses to replace an existing one unless o
 from __future__ import annotations
 
 import math
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -12,12 +15,47 @@ import numpy as np
 from . import collisions as C
 
 
-def _target(path, overwrite: bool) -> Path:
+def _target(path, overwrite: bool, suffix: str = ".png") -> Path:
+    """The file a picture goes to, checked before any work: `suffix` is added when the name has
+    none (so the file checked is the file written), a folder is refused, and so is an existing
+    file or any symlink (dangling ones too) unless overwrite=True."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ValueError(f"path: expected a file name, got {path!r}")
     p = Path(path)
-    if p.exists() and not overwrite:
+    if p.suffix == "":
+        p = p.with_suffix(suffix)
+    if p.suffix.lower() != suffix:
+        raise ValueError(f"path: {str(p)!r} must end in {suffix} (the picture is written as {suffix[1:].upper()})")
+    if p.is_dir():
+        raise ValueError(f"path: {str(p)!r} is a folder")
+    if (p.exists() or p.is_symlink()) and not overwrite:
         raise ValueError(f"path: {str(p)!r} exists; pass overwrite=True (or --force) to replace it")
     if not p.parent.is_dir():
         raise ValueError(f"path: folder {str(p.parent)!r} does not exist")
+    return p
+
+
+def _write(p: Path, overwrite: bool, save) -> Path:
+    """save(tmp) writes the picture to a new file beside p, which then becomes p: copied into a
+    file created exclusively (what appeared in between is never replaced), or, with overwrite,
+    renamed over p (a symlink is replaced itself; what it pointed to is never written)."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}-", suffix=p.suffix, dir=p.parent)
+    os.close(fd)
+    try:
+        save(tmp)
+        os.chmod(tmp, 0o644)
+        if overwrite:
+            os.replace(tmp, p)
+        else:
+            try:
+                out = open(p, "xb")  # exclusive: never replaces what is there
+            except FileExistsError:
+                raise ValueError(f"path: {str(p)!r} appeared while the picture was drawn; not replaced") from None
+            with out, open(tmp, "rb") as src:
+                shutil.copyfileobj(src, out)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
     return p
 
 
@@ -58,7 +96,7 @@ def clearance(pair, path, overwrite: bool = False, samples: int = 2001) -> Path:
     ax.set_title(f"{pair!r}: first touch {lim.what}", fontsize=9)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(p, dpi=120)
+    _write(p, overwrite, lambda f: fig.savefig(f, dpi=120, format="png"))
     plt.close(fig)
     return p
 
@@ -71,31 +109,40 @@ def workspace(ws, path, overwrite: bool = False, max_points: int = 20_000) -> Pa
     rng = np.random.default_rng(0)
     pts = ws.points
     show = pts[rng.choice(len(pts), min(max_points, len(pts)), replace=False)]
-    centre = 0.5 * (ws.boundary.min(axis=0) + ws.boundary.max(axis=0))
     fig = plt.figure(figsize=(12, 9))
     ax = fig.add_subplot(2, 2, 1, projection="3d")
     ax.scatter(*show.T, s=0.3, alpha=0.3)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_zlabel("z [m]")
-    ax.set_title(f"{ws.chain_name}: V = {ws.volume:.4g} ± {ws.volume_error:.2g} m³ ({len(pts)} samples)", fontsize=9)
+    _axes_3d(ax, pts)
+    what = (f"V = {ws.volume:.4g} ± {ws.volume_error:.2g} m³" if ws.dimension == 3 else
+            f"{'curve, length' if ws.dimension == 1 else 'surface, area'} ≈ {ws.measure:.4g} m{'' if ws.dimension == 1 else '²'}")
+    ax.set_title(f"{ws.chain_name}: {what} ({len(pts)} samples)", fontsize=9)
     names = "xyz"
     for k, axis in enumerate(range(3)):
         a, b = [i for i in range(3) if i != axis]
-        slab = np.abs(pts[:, axis] - centre[axis]) < 0.5 * ws.voxel
-        edge = np.abs(ws.boundary[:, axis] - centre[axis]) < 0.5 * ws.voxel
+        layer, slab, edge = section(ws, axis)
         sub = fig.add_subplot(2, 2, k + 2)
         sub.scatter(pts[slab, a], pts[slab, b], s=0.3, alpha=0.3, label="samples")
         sub.scatter(ws.boundary[edge, a], ws.boundary[edge, b], s=4, c="C3", marker="s", label="boundary voxels")
         sub.set_aspect("equal")
         sub.set_xlabel(f"{names[a]} [m]")
         sub.set_ylabel(f"{names[b]} [m]")
-        sub.set_title(f"section {names[axis]} = {centre[axis]:.3g} m", fontsize=9)
+        sub.set_title(f"section {names[axis]} = {layer:.3g} m", fontsize=9)
     sub.legend(loc="upper right", fontsize=7, markerscale=3)
     fig.tight_layout()
-    fig.savefig(p, dpi=110)
+    _write(p, overwrite, lambda f: fig.savefig(f, dpi=110, format="png"))
     plt.close(fig)
     return p
+
+
+def section(ws, axis: int):
+    """The cross-section of a workspace normal to `axis` through the centre of its boundary: the
+    layer of voxel centres nearest that centre (they lie on a lattice the centre may fall half-way
+    between), and masks of the samples within half a voxel of it and of its boundary voxels."""
+    centre = 0.5 * (ws.boundary[:, axis].min() + ws.boundary[:, axis].max())
+    layer = ws.boundary[np.argmin(np.abs(ws.boundary[:, axis] - centre)), axis]
+    slab = np.abs(ws.points[:, axis] - layer) < 0.5 * ws.voxel
+    edge = np.abs(ws.boundary[:, axis] - layer) < 0.25 * ws.voxel
+    return float(layer), slab, edge
 
 
 def segments(chain, q) -> list[tuple[np.ndarray, np.ndarray, str]]:
@@ -122,31 +169,84 @@ def segments(chain, q) -> list[tuple[np.ndarray, np.ndarray, str]]:
     return out
 
 
-def _draw(ax, chain, q):
-    style = {"link": dict(color="k", lw=2.5), "leg": dict(color="C0", lw=1.2), "plate": dict(color="C1", lw=1.5)}
+def _triangles(chain, q) -> list[np.ndarray]:
+    """The plates at q as filled triangles (3, 3): each A-pair's base and platform triangle."""
+    tris = []
     for a, b, kind in segments(chain, q):
-        ax.plot(*np.stack([a, b]).T, **style[kind])
+        if kind == "plate":
+            tris.append(a)
+    return [np.stack(tris[k: k + 3]) for k in range(0, len(tris), 3)]
 
 
-def _equal_3d(ax, pts):
+def _draw(ax, chain, q, extent: float):
+    """Links (black), legs (blue, drawn as wide as their real radius where one is given), plates
+    (filled orange triangles), the base (square) and the end effector (triangle, with its frame)."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    points_per_m = 72 * 0.8 * ax.figure.get_figwidth() / (2 * extent)  # the axes span about 2·extent
+    legs = [p.leg_radius for p in chain.pairs if p.kind != "revolute" for _ in range(6)]
+    k = 0
+    for a, b, kind in segments(chain, q):
+        if kind == "link":
+            ax.plot(*np.stack([a, b]).T, color="k", lw=2.5, solid_capstyle="round")
+        elif kind == "leg":
+            lw = max(0.8, 2 * legs[k] * points_per_m) if legs[k] > 0 else 1.0
+            ax.plot(*np.stack([a, b]).T, color="C0", lw=lw, solid_capstyle="round")
+            k += 1
+    tris = _triangles(chain, q)
+    if tris:
+        ax.add_collection3d(Poly3DCollection(tris, facecolor="C1", edgecolor="C1", alpha=0.45, linewidths=1.0))
+    T = chain.fk(q)
+    ax.scatter([0], [0], [0], marker="s", s=40, color="k", label="base")
+    ax.scatter(*T[:3, 3, None], marker="^", s=50, color="C3", label="end effector")
+    for axis, colour in zip(T[:3, :3].T, ("tab:red", "tab:green", "tab:blue")):
+        ax.plot(*np.stack([T[:3, 3], T[:3, 3] + 0.15 * extent * axis]).T, color=colour, lw=1.2)
+
+
+def _axes_3d(ax, pts) -> float:
+    """Equal scale on all three axes around the points, labelled with units, readable ticks;
+    returns the half-extent [m]."""
+    from matplotlib.ticker import MaxNLocator
+
+    extent = _equal_3d(ax, pts)
+    ax.set_box_aspect((1, 1, 1))
+    for name, axis in zip("xyz", (ax.xaxis, ax.yaxis, ax.zaxis)):
+        axis.set_major_locator(MaxNLocator(4))
+        axis.set_tick_params(labelsize=8)
+    ax.set_xlabel("x [m]", fontsize=9)
+    ax.set_ylabel("y [m]", fontsize=9)
+    ax.set_zlabel("z [m]", fontsize=9)
+    return extent
+
+
+def _equal_3d(ax, pts) -> float:
+    """Limits of one common span around the points (a margin of 10 %); returns the half-span."""
     c = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
-    r = 0.5 * max(float(np.max(pts.max(axis=0) - pts.min(axis=0))), 1e-3)
+    r = 0.55 * max(float(np.max(pts.max(axis=0) - pts.min(axis=0))), 1e-3)
     ax.set_xlim(c[0] - r, c[0] + r)
     ax.set_ylim(c[1] - r, c[1] + r)
     ax.set_zlim(c[2] - r, c[2] + r)
+    return r
+
+
+def _scene_points(chain, q) -> np.ndarray:
+    return np.array([x for a, b, _ in segments(chain, q) for x in (a, b)] + [np.zeros(3)])
 
 
 def chain_picture(chain, q, path, overwrite: bool = False) -> Path:
-    """A 3D picture of the chain at q: links (black), legs (blue), plates (orange)."""
+    """A 3D picture of the chain at q, fit for a paper: equal scale on all axes, labelled in
+    metres; links (black), legs (blue, their real radius where given), plates (filled orange),
+    the base (square) and the end effector (triangle, with its frame: x red, y green, z blue)."""
     p = _target(path, overwrite)
     q = chain._q(q)
     plt = _figure()
     fig = plt.figure(figsize=(6, 6))
     ax = fig.add_subplot(projection="3d")
-    _draw(ax, chain, q)
-    _equal_3d(ax, np.array([x for a, b, _ in segments(chain, q) for x in (a, b)]))
+    extent = _axes_3d(ax, _scene_points(chain, q))
+    _draw(ax, chain, q, extent)
+    ax.legend(loc="upper left", fontsize=8)
     ax.set_title(f"{getattr(chain, 'name', '')} at q = {np.round(q, 3).tolist()} rad", fontsize=9)
-    fig.savefig(p, dpi=110)
+    _write(p, overwrite, lambda f: fig.savefig(f, dpi=150, format="png", bbox_inches="tight"))
     plt.close(fig)
     return p
 
@@ -157,7 +257,7 @@ def pair_animation(pair, path, frames: int = 48, overwrite: bool = False) -> Pat
 
     from .chain import AChain
 
-    p = _target(path, overwrite)
+    p = _target(path, overwrite, suffix=".gif")
     if pair.kind == "revolute":
         raise ValueError("pair: an R-pair has no legs to animate")
     lim = pair.collision_limits()
@@ -172,11 +272,12 @@ def pair_animation(pair, path, frames: int = 48, overwrite: bool = False) -> Pat
 
     def frame(k):
         ax.cla()
-        _draw(ax, chain, [angles[k]])
-        _equal_3d(ax, every)
+        extent = _axes_3d(ax, every)
+        _draw(ax, chain, [angles[k]], extent)
         ax.set_title(f"theta = {math.degrees(angles[k]):+7.2f} deg  (limits {math.degrees(lo):.1f}, "
                      f"{math.degrees(hi):.1f}: {lim.what})", fontsize=8)
 
-    FuncAnimation(fig, frame, frames=len(angles)).save(p, writer=PillowWriter(fps=12))
+    anim = FuncAnimation(fig, frame, frames=len(angles))
+    _write(p, overwrite, lambda f: anim.save(f, writer=PillowWriter(fps=12)))
     plt.close(fig)
     return p

@@ -34,6 +34,10 @@ OFFSETS = 3  # random grid offsets per voxel size
 BATCH = 50_000
 COVERAGE_FACTOR = 2.0  # the remaining coverage deficit, in units of the last doubling's change
 COARSER = 1.5  # the same estimate with voxels this much larger measures the resolution's effect
+MAX_GRID_BYTES = 2 * 2**30  # a voxel grid larger than this is refused, not attempted
+MAX_SAMPLE_BYTES = 8 * 2**30  # the kept samples (points, joint values, poses)
+LOCAL_ENGINES = ("threads", "processes", "synchronous")
+CONNECT_TIMEOUT = "10s"  # to reach a scheduler address
 
 
 @dataclass
@@ -43,6 +47,8 @@ class Workspace:
     points: (m, 3) end-effector origins of all samples; poses: (m, 8) their Study points (if
     asked for); q: (m, n) the joint samples; boundary: (k, 3) centres of the boundary voxels of
     size `voxel`; volume, volume_error: the extrapolated volume [m³] and one standard uncertainty;
+    dimension: that of the set of reachable points (3, or 1 and 2 for a curve or a surface, whose
+    volume is None and whose length [m] or area [m²] estimate is `measure`);
     history: (samples, corrected occupancy volume at h₀) after each round, the convergence record.
     """
 
@@ -50,11 +56,23 @@ class Workspace:
     q: np.ndarray
     boundary: np.ndarray
     voxel: float
-    volume: float
-    volume_error: float
+    volume: float | None
+    volume_error: float | None
     poses: np.ndarray | None = None
     history: list = field(default_factory=list)
     chain_name: str = ""
+    dimension: int = 3
+    measure: float | None = None
+
+    @property
+    def summary(self) -> str:
+        """One line: the volume with its uncertainty, or what a curve or surface is instead."""
+        if self.dimension == 3:
+            return f"volume {self.volume:.6g} ± {self.volume_error:.2g} m^3 (one standard uncertainty)"
+        kind, unit = ("a curve", "length") if self.dimension == 1 else ("a surface", "area")
+        power = "" if self.dimension == 1 else "^2"
+        return (f"{kind} (dimension {self.dimension}, no volume); estimated {unit} {self.measure:.4g} m{power} "
+                f"(from voxel crossings, a few per cent)")
 
     def plot(self, path, overwrite: bool = False):
         """A 3D view of the points and three cross-sections through the centre (matplotlib)."""
@@ -91,17 +109,18 @@ def _run(tasks, engine, progress):
     import dask
 
     delayed = [dask.delayed(_batch)(*t) for t in tasks]
-    if engine in ("threads", "processes", "synchronous"):
+    if isinstance(engine, str) and engine in LOCAL_ENGINES:
         res = dask.compute(*delayed, scheduler=engine)
     else:
         from dask.distributed import Client
 
         client = engine if isinstance(engine, Client) else None
         if client is None:
-            if not isinstance(engine, str):
-                raise ValueError(f"engine: expected None, 'threads', 'processes', a scheduler address or a "
-                                 f"dask.distributed.Client, got {engine!r}")
-            client = Client(engine)
+            try:
+                client = Client(engine, timeout=CONNECT_TIMEOUT)
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise ValueError(f"engine: cannot reach a Dask scheduler at {engine!r} within {CONNECT_TIMEOUT} "
+                                 f"({type(exc).__name__}: {exc})") from None
         try:
             res = client.gather(client.compute(delayed))
         finally:
@@ -110,6 +129,22 @@ def _run(tasks, engine, progress):
     if progress:
         progress(len(tasks), len(tasks))
     return list(res)
+
+
+def _check_engine(engine) -> None:
+    """engine: None, a local Dask scheduler name, a scheduler address or a Client."""
+    if engine is None:
+        return
+    if isinstance(engine, str):
+        if engine in LOCAL_ENGINES or "://" in engine or ":" in engine:
+            return
+        raise ValueError(f"engine: expected None, one of {LOCAL_ENGINES}, a scheduler address (tcp://host:port) "
+                         f"or a dask.distributed.Client, got {engine!r}")
+    from dask.distributed import Client
+
+    if not isinstance(engine, Client):
+        raise ValueError(f"engine: expected None, one of {LOCAL_ENGINES}, a scheduler address or a "
+                         f"dask.distributed.Client, got {engine!r}")
 
 
 def _voxels(points, origin, h):
@@ -179,9 +214,17 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
     """
     from . import _validate as V
 
-    samples = int(V.scalar("samples", samples, positive=True))
-    resolution = int(V.scalar("resolution", resolution, positive=True))
-    rounds = int(V.scalar("rounds", rounds, positive=True))
+    samples = V.integer("samples", samples)
+    resolution = V.integer("resolution", resolution)
+    rounds = V.integer("rounds", rounds)
+    _check_engine(engine)
+    grid = (resolution + 4) ** 3  # bytes of the finest voxel grid (booleans, one voxel of margin a side)
+    if grid > MAX_GRID_BYTES:
+        top = int(MAX_GRID_BYTES ** (1 / 3)) - 4
+        raise ValueError(f"resolution: {resolution} voxels along the longest side need voxel grids of about "
+                         f"{grid / 2**30:.1f} GiB; at most {top} fit in {MAX_GRID_BYTES / 2**30:.0f} GiB")
+    if samples * (3 + len(chain.pairs)) * 8 * (2 if poses else 1) > MAX_SAMPLE_BYTES:
+        raise ValueError(f"samples: {samples} samples need more than {MAX_SAMPLE_BYTES / 2**30:.0f} GiB to keep")
     if samples < 1000 * rounds:
         raise ValueError(f"samples: at least {1000 * rounds} are needed for {rounds} rounds, got {samples}")
     if resolution < 4:
@@ -219,6 +262,13 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
             h0 = side / resolution
             origin = box_lo - 0.5 * h0
         history.append((len(pts), _corrected_volume(pts, origin, h0)))
+    dimension = _dimension(chain, qs, side)
+    edge = _boundary(pts, origin, h0)
+    if dimension < 3:
+        return Workspace(points=pts, q=qs, boundary=origin + (edge + 0.5) * h0, voxel=h0, volume=None,
+                         volume_error=None, poses=np.concatenate([p["poses"] for p in parts]) if poses else None,
+                         history=history, chain_name=getattr(chain, "name", ""), dimension=dimension,
+                         measure=_measure(chain, pts, qs, origin, h0, dimension))
     rng = np.random.default_rng((seed, 99))
     volume, fit_err = _estimate(pts, origin, h0, rng)
     coarse, _ = _estimate(pts, origin, COARSER * h0, np.random.default_rng((seed, 99)))
@@ -229,10 +279,35 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
     else:
         volume += missing
     error = math.sqrt(fit_err**2 + missing**2 + (volume - missing - coarse) ** 2)
-    edge = _boundary(pts, origin, h0)
     return Workspace(points=pts, q=qs, boundary=origin + (edge + 0.5) * h0, voxel=h0, volume=volume,
                      volume_error=error, poses=np.concatenate([p["poses"] for p in parts]) if poses else None,
                      history=history, chain_name=getattr(chain, "name", ""))
+
+
+def _dimension(chain, qs, side: float, probes: int = 256) -> int:
+    """The dimension of the reachable point set: the largest rank of the position rows of the
+    Jacobian over a spread of samples (relative tolerance 1e-7 of the workspace's size)."""
+    J = chain.jacobian(qs[:: max(1, len(qs) // probes)])[:, :3, :]
+    return int(np.linalg.matrix_rank(J, tol=1e-7 * max(side, 1e-300)).max())
+
+
+def _measure(chain, pts, qs, origin, h, dimension: int) -> float:
+    """Length (dimension 1) or area (2) of the reachable set from the voxels its samples occupy:
+    a curve with unit tangent t crosses |t|₁/h voxels per unit length, a surface with unit normal n
+    |n|₁/h² per unit area, so each occupied voxel contributes h/|t|₁ (h²/|n|₁) with the tangent
+    (normal) of one sample in it, from the Jacobian there; measured at the voxel sizes LEVELS and
+    extrapolated linearly to size 0."""
+    def at(size):
+        idx = np.floor((pts - origin) / size).astype(np.int64)
+        _, first = np.unique(idx, axis=0, return_index=True)
+        U = np.linalg.svd(chain.jacobian(qs[first])[:, :3, :])[0]  # (k, 3, 3): left singular vectors
+        direction = U[:, :, 0] if dimension == 1 else U[:, :, 2]  # the tangent, or the normal
+        return float(np.sum(size**dimension / np.abs(direction).sum(axis=1)))
+
+    # voxels at the rim (the ends) are partly outside: an excess of order h, extrapolated away
+    sizes = h * np.array(LEVELS)
+    values = [at(size) for size in sizes]
+    return float(np.polyfit(sizes, values, 1)[1])
 
 
 def _coverage_remainder(history) -> float | None:
