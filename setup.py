@@ -1,19 +1,23 @@
 """Builds the Python binding of the generated C kernels: the extension module apair._native.
 
 It compiles generated/c (the kernels and their registry) with src/apair/_native.c, which calls
-any registered kernel on NumPy arrays. The extension is optional: without a C compiler the install
-still succeeds and the runtime falls back to the generated NumPy kernels (and says so).
+any registered kernel on NumPy arrays. A failed build (no C compiler, most often) stops the
+install with a message that says what to do, at install time rather than at the first call:
+install gcc, or set APAIR_NO_C=1 to install without the binding (the runtime then uses the
+generated NumPy kernels and says so once).
 
 Flags: ISO C (-std=c11, so no floating-point contraction: the results match the NumPy kernels'
 rounding) and -fno-math-errno (libm need not set errno, which lets the compiler fuse sin and cos
 of one angle into sincos; results are unchanged).
 """
 import hashlib
+import os
 from glob import glob
 from pathlib import Path
 
 import numpy
 from setuptools import Extension, setup
+from setuptools.command.build_ext import build_ext
 
 C_FILES = sorted(glob("generated/c/*.c") + glob("generated/c/*.h"))
 
@@ -27,7 +31,26 @@ def sources_hash(paths) -> str:
     return h.hexdigest()
 
 
+class BuildExt(build_ext):
+    """build_ext that says at install time why the C kernels are missing, or skips them on request."""
+
+    def run(self):
+        if os.environ.get("APAIR_NO_C"):
+            print("apair: APAIR_NO_C is set, installing without the compiled C kernels (the NumPy kernels "
+                  "will be used)")
+            self.extensions = []
+            return
+        try:
+            super().run()
+        except Exception as exc:  # setuptools' CompileError, a missing compiler's OSError, ...
+            raise SystemExit(
+                f"apair: the C kernels could not be compiled ({type(exc).__name__}: {exc}). Install a C "
+                "compiler (e.g. apt install gcc) and retry, or set APAIR_NO_C=1 to install without them "
+                "(the runtime then uses the slower NumPy kernels).") from None
+
+
 setup(
+    cmdclass={"build_ext": BuildExt},
     ext_modules=[
         Extension(
             "apair._native",
@@ -37,7 +60,6 @@ setup(
             extra_compile_args=["-std=c11", "-O2", "-fno-math-errno"],
             libraries=["m"],
             define_macros=[("APAIR_SOURCES_HASH", f'"{sources_hash(C_FILES)}"')],
-            optional=True,
         )
     ]
 )

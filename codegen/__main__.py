@@ -15,8 +15,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from .emitter import Emitter, lower, render_polynomials, write
-from .varieties import PREFIX as VARIETY_PREFIX
+from .emitter import Emitter, OutputError, lower, render_polynomials, write
 
 DERIVATIONS = ("apair_collisions", "apair_pair", "apair_dynamics", "chain_kinematics", "chain_dynamics",
                "chain_variety")
@@ -73,7 +72,11 @@ def main(argv=None) -> int:
               f"({seconds:.1f} s)", file=sys.stderr)
     t0 = time.perf_counter()
     files = Emitter().render(lowered, poly_files)
-    changed = write(files, args.out, clean=args.only is None, keep=(f"polynomials/{VARIETY_PREFIX}",))
+    try:
+        changed = write(files, args.out, clean=args.only is None)
+    except OutputError as exc:
+        print(f"python -m codegen: error: {exc}", file=sys.stderr)
+        return 2
     print(f"emitted {len(files)} files ({time.perf_counter() - t0:.1f} s; {time.perf_counter() - t_start:.1f} s "
           f"in all with {args.jobs} jobs); changed: {len(changed)}", file=sys.stderr)
     for c in changed:

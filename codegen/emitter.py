@@ -260,9 +260,10 @@ class Emitter:
         files["numpy/__init__.py"] = self.env.get_template("numpy_init.py.j2").render(
             modules=sorted(lowered), kernels=sorted((k.name, stem) for stem, ks in lowered.items() for k in ks),
             hash=header_hash)
-        files["manifest.json"] = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
         files["__init__.py"] = (f'"""Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.\n\n'
                                 f'Content hash: {header_hash}\n"""\n')
+        manifest["files"] = sorted(set(files) | {"manifest.json"})  # what a later run may replace or remove
+        files["manifest.json"] = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
         return files
 
 
@@ -293,9 +294,33 @@ def sources_hash(texts: dict[str, str]) -> str:
     return h.hexdigest()
 
 
-def write(files: dict[str, str], out: Path, clean: bool = True, keep: tuple[str, ...] = ()) -> list[str]:
-    """Write files under `out`; with `clean`, remove generated files no longer produced (except
-    those whose path starts with one of `keep`: another step writes them). Returns changes."""
+class OutputError(Exception):
+    """The output folder is not one the generator may write into."""
+
+
+def owned_files(out: Path) -> set[str] | None:
+    """The files a previous run wrote into `out` (from its manifest.json), or None when `out`
+    holds no manifest of ours."""
+    try:
+        data = json.loads((out / "manifest.json").read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or "kernels" not in data or "content_hash" not in data:
+        return None
+    return set(data.get("files", []))
+
+
+def write(files: dict[str, str], out: Path, clean: bool = True) -> list[str]:
+    """Write files under `out`; with `clean`, remove the files an earlier run listed in its
+    manifest that are no longer produced, and nothing else. A non-empty `out` that holds no
+    manifest of ours is refused (OutputError): its files belong to someone else. Returns the
+    changes."""
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"--out: {out} is not a folder")
+    previous = owned_files(out) if out.exists() else set()
+    if previous is None and any(out.iterdir()):
+        raise OutputError(f"--out: {out} is not empty and was not written by codegen (no manifest.json of "
+                          "ours): give an empty or new folder")
     changed = []
     out.mkdir(parents=True, exist_ok=True)
     for rel, text in sorted(files.items()):
@@ -305,9 +330,9 @@ def write(files: dict[str, str], out: Path, clean: bool = True, keep: tuple[str,
             path.write_text(text)
             changed.append(rel)
     if clean:
-        for path in sorted(out.rglob("*")):
-            rel = path.relative_to(out).as_posix()
-            if path.is_file() and rel not in files and "__pycache__" not in rel and not rel.startswith(keep):
+        for rel in sorted((previous or set()) - set(files)):
+            path = out / rel
+            if path.is_file():
                 path.unlink()
                 changed.append(f"removed {rel}")
     return changed

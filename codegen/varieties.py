@@ -15,7 +15,7 @@ from pathlib import Path
 
 from derivations.spec import Entry, PolynomialSet
 
-from .emitter import content_hash, write
+from .emitter import OutputError, content_hash, write
 from .polynomials import render_polynomial_set
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -58,7 +58,11 @@ def main(argv=None) -> int:
             files.update(render_polynomial_set(ps, content_hash))
             print(f"variety of {path.name}: {len(ps.entries)} equations ({time.perf_counter() - t0:.1f} s)",
                   file=sys.stderr)
-    changed = write(files, args.out, clean=False)
+    try:
+        changed = write(files, args.out, clean=False)
+    except OutputError as exc:
+        print(f"python -m codegen.varieties: error: {exc}", file=sys.stderr)
+        return 2
     for c in changed:
         print(f"  {c}", file=sys.stderr)
     return 0

@@ -247,9 +247,9 @@ def test_cmake_install_serves_find_package_and_pkg_config(cmake, tmp_path):
     """Install the library, then build the example against it with find_package(apair) and with
     the flags pkg-config gives."""
     prefix = tmp_path / "prefix"
-    run([cmake, "-S", str(CDIR), "-B", str(tmp_path / "lib"), f"-DCMAKE_INSTALL_PREFIX={prefix}"])
+    run([cmake, "-S", str(CDIR), "-B", str(tmp_path / "lib")])  # the README's recipe: prefix at install time
     run([cmake, "--build", str(tmp_path / "lib"), "--parallel", "2"])
-    run([cmake, "--install", str(tmp_path / "lib")])
+    run([cmake, "--install", str(tmp_path / "lib"), "--prefix", str(prefix)])
     assert (prefix / "include" / "apair.h").exists()
     consumer = tmp_path / "consumer"
     consumer.mkdir()
@@ -272,6 +272,12 @@ def test_cmake_install_serves_find_package_and_pkg_config(cmake, tmp_path):
     exe = tmp_path / "chain_4a_pc"
     run(["cc", "-std=c99", str(EXAMPLE), *flags, "-o", str(exe)])
     check_example(exe)
+    # relocatable: the installed tree moved elsewhere still gives flags that point into it
+    moved = tmp_path / "moved"
+    prefix.rename(moved)
+    env = dict(os.environ, PKG_CONFIG_PATH=os.pathsep.join(str(p.parent) for p in moved.rglob("apair.pc")))
+    flags = run([pkg_config, "--cflags", "--libs", "apair"], env=env).stdout.split()
+    assert any(f.startswith("-I") and Path(f[2:]).resolve() == (moved / "include").resolve() for f in flags), flags
 
 
 def test_driver_detects_a_broken_kernel(driver, tmp_path):
