@@ -165,7 +165,7 @@ def test_ik_keeps_or_marks_solutions_by_the_limits():
     chain = apair.AChain([pair, apair.APair(0.05, 0.025, leg_radius=0.001)], [0.3, 0.2], [1.1, 0.0])
     lim = chain.limits
     inside = np.array([0.5 * lim[0, 1], 0.3 * lim[1, 0]])
-    outside = np.array([0.5 * (lim[0, 1] + math.pi), 0.2])  # beyond joint 0's collision limit
+    outside = np.array([0.5 * (lim[0, 1] + math.pi), 0.2])  # beyond joint 1's collision limit
     assert chain.within_limits(np.stack([inside, outside])).tolist() == [True, False]
     for q, kept in ((inside, 1), (outside, 0)):
         T = chain.fk(q)

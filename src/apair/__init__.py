@@ -1,9 +1,9 @@
 """apair: closed-form kinematics of algebraic screw pairs (A-pairs) and A-chains.
 
 The closed forms are derived symbolically (derivations/), emitted as C and NumPy kernels
-(codegen/ -> generated/), and loaded here. See CONVENTIONS.md for frames and conventions.
+(codegen/ -> generated/), and loaded here. See docs/conventions.md for frames and conventions.
 """
-from . import polynomials
+from . import plots, polynomials  # plots imports matplotlib only when a picture is drawn
 from .chain import AChain
 from .io import load
 from .kernels import backend, c_available, set_backend
@@ -12,4 +12,4 @@ from .pair import APair
 from .simulate import Trajectory
 
 __version__ = "0.1.0"
-__all__ = ["APair", "AChain", "Link", "Trajectory", "load", "polynomials", "set_backend", "backend", "c_available", "__version__"]
+__all__ = ["APair", "AChain", "Link", "Trajectory", "load", "plots", "polynomials", "set_backend", "backend", "c_available", "__version__"]

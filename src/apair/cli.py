@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 
 import numpy as np
@@ -120,15 +121,18 @@ def _cmd_ik(args) -> int:
     with np.printoptions(precision=12, suppress=True, floatmode="maxprec"):
         if len(sol.q) == 0:
             dp, dr, q = distance(chain, T)
-            print(f"{chain.name}: the pose is unreachable. The nearest pose found (q = {q} rad) is "
-                  f"{dp:.3e} m and {dr:.3e} rad away.")
+            why = "" if sol.certified else (" (not certified: the exact elimination degenerated at this pose, "
+                                            "and the local search found no solution)")
+            print(f"{chain.name}: the pose is unreachable{why}. The nearest pose found inside the joint limits "
+                  f"(q = {q} rad) is {dp:.3e} m and {dr:.3e} rad away.")
             return 1
-        print(f"{chain.name}: {len(sol.q)} real solution(s) of {sol.complex_count} complex; "
-              f"angles in rad{' and deg' if args.deg else ''}")
-        inside = chain.within_limits(sol.q)
-        for q, e, ok in zip(sol.q, sol.error, inside):
+        complete = "" if sol.certified else "; found by the local fallback search, not certified complete"
+        count = f" of {sol.complex_count} complex" if sol.complex_count is not None else ""
+        print(f"{chain.name}: {len(sol.q)} real solution(s){count}{complete}; angles in rad"
+              f"{' and deg' if args.deg else ''}")
+        for q, e, ok in zip(sol.q, sol.error, sol.inside):
             extra = f"  = {np.degrees(q)} deg" if args.deg else ""
-            print(f"  q = {q}{extra}   |fk(q) - T| = {e:.1e}{'' if ok else '   outside the joint limits'}")
+            print(f"  q = {q}{extra}   |fk(q) - T| = {e:.1e}   {'within' if ok else 'OUTSIDE'} the joint limits")
     return 0
 
 
@@ -138,14 +142,14 @@ def _cmd_limits(args) -> int:
     print(f"{chain.name}: joint ranges [deg] (explicit, or where the legs or plates first touch)")
     for i, p in enumerate(chain.pairs):
         what = "explicit" if chain._explicit_limits[i] is not None else p.collision_limits().what
-        print(f"  joint {i}: {np.degrees(lim[i, 0]):+10.4f} .. {np.degrees(lim[i, 1]):+10.4f}   {what}")
+        print(f"  joint {i + 1}: {np.degrees(lim[i, 0]):+10.4f} .. {np.degrees(lim[i, 1]):+10.4f}   {what}")
     if args.plot:
         from .plots import clearance
 
         k = next((i for i, p in enumerate(chain.pairs) if p.kind != "revolute"), None)
         if k is None:
             raise ValueError("file: the chain has no A-pair to plot")
-        print(f"clearance of joint {k} written to {clearance(chain.pairs[k], args.plot, overwrite=args.force)}")
+        print(f"clearance of joint {k + 1} written to {clearance(chain.pairs[k], args.plot, overwrite=args.force)}")
     return 0
 
 
@@ -159,8 +163,8 @@ def _cmd_workspace(args) -> int:
         _target(args.plot, args.force)  # refuse before the long run, not after it
     ws = chain.workspace(samples=args.samples, resolution=args.resolution, engine=args.scheduler,
                          progress=text_progress() if not args.quiet else None)
-    print(f"{chain.name}: workspace volume {ws.volume:.6g} ± {ws.volume_error:.2g} m^3 (one standard "
-          f"uncertainty) from {len(ws.points)} samples; voxel {ws.voxel:.3g} m, {len(ws.boundary)} boundary voxels")
+    print(f"{chain.name}: workspace {ws.summary} from {len(ws.points)} samples; voxel {ws.voxel:.3g} m, "
+          f"{len(ws.boundary)} boundary voxels")
     lo, hi = ws.points.min(axis=0), ws.points.max(axis=0)
     print(f"  bounding box [m]: x {lo[0]:+.4f} .. {hi[0]:+.4f}, y {lo[1]:+.4f} .. {hi[1]:+.4f}, "
           f"z {lo[2]:+.4f} .. {hi[2]:+.4f}")
@@ -229,13 +233,34 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    """Run one command; every failure ends in a one-line message and a non-zero exit, never a
+    traceback: 2 for bad input, 1 for an unreachable pose, 141 when the reader of the output went
+    away (`apair kernels | head`), 130 on Ctrl-C, 3 for an internal error."""
     ap = build_parser()
     args = ap.parse_args(argv)
     try:
-        return args.func(args)
-    except ValueError as exc:
-        print(f"apair {args.command}: error: {exc}", file=sys.stderr)
+        code = args.func(args)
+        sys.stdout.flush()
+        return code
+    except BrokenPipeError:
+        # the reader closed the pipe: stop quietly, and keep Python from complaining at exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
+    except KeyboardInterrupt:
+        print(f"apair {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except (ValueError, OSError) as exc:
+        print(f"apair {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except Exception as exc:  # noqa: BLE001 (the CLI's promise: no traceback, a line to report)
+        print(f"apair {args.command}: internal error: {type(exc).__name__}: {_one_line(exc)} "
+              "(please report this with the command line)", file=sys.stderr)
+        return 3
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text if len(text) <= 400 else text[:397] + "..."
 
 
 if __name__ == "__main__":

@@ -22,6 +22,7 @@
 from __future__ import annotations
 
 import math
+import os
 import tomllib
 from pathlib import Path
 
@@ -41,10 +42,13 @@ _LINK_KEYS = {"mass", "com", "inertia"}
 
 
 def _numbers(where: str, v, shapes):
-    arr = np.asarray(v, dtype=object)
+    try:
+        arr = np.asarray(v, dtype=object)
+    except ValueError:  # ragged nesting
+        arr = np.empty(0, dtype=object)
     if arr.shape not in shapes or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in arr.flat):
-        raise ValueError(f"{where}: expected numbers of shape {' or '.join(map(str, shapes))}, got {v!r}")
-    return np.asarray(v, dtype=float)
+        raise ValueError(f"{where}: expected numbers of shape {' or '.join(map(str, shapes))}, got {_short(v)}")
+    return np.array([_number(where, x) for x in arr.flat]).reshape(arr.shape)
 
 
 def _link(w: str, j: dict) -> Link:
@@ -96,8 +100,20 @@ def _limits(where: str, j: dict, pair: APair):
 
 def _number(where: str, v):
     if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise ValueError(f"{where}: expected a number, got {v!r}")
-    return float(v)
+        raise ValueError(f"{where}: expected a number, got {_short(v)}")
+    try:
+        x = float(v)
+    except OverflowError:
+        raise ValueError(f"{where}: {_short(v)} is too large for a double") from None
+    if not math.isfinite(x):
+        raise ValueError(f"{where}: expected a finite number, got {v!r}")
+    return x
+
+
+def _short(v, limit: int = 60) -> str:
+    """repr(v), cut to `limit` characters (a value in an error message, not a dump)."""
+    text = repr(v)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def chain_from_dict(data: dict, where: str = "chain") -> AChain:
@@ -112,10 +128,10 @@ def chain_from_dict(data: dict, where: str = "chain") -> AChain:
     for i, j in enumerate(joints):
         w = f"{where}: joint {i + 1}"
         if not isinstance(j, dict):
-            raise ValueError(f"{w}: expected a [[joint]] table, got {j!r}")
+            raise ValueError(f"{w}: expected a [[joint]] table, got {_short(j)}")
         kind = j.get("pair")
         if kind not in KINDS:
-            raise ValueError(f"{w}.pair: expected one of {KINDS}, got {kind!r}")
+            raise ValueError(f"{w}.pair: expected one of {KINDS}, got {_short(kind)}")
         allowed = _PAIR_KEYS[kind] | _DH_KEYS | _LINK_KEYS | {"pair"}
         unknown = set(j) - allowed
         if unknown:
@@ -146,17 +162,35 @@ def chain_from_dict(data: dict, where: str = "chain") -> AChain:
         raise ValueError(f"{where}: {exc}") from None
 
 
+MAX_FILE_BYTES = 16 * 2**20  # a chain file is a few kB; anything this large is not one
+
+
 def load(path) -> AChain:
-    """Read a chain from a TOML file."""
+    """Read a chain from a TOML file (UTF-8, a byte-order mark allowed)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ValueError(f"path: expected a file name, got {_short(path)}")
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise ValueError(f"path: no such file {str(p)!r}")
+    if p.is_dir():
+        raise ValueError(f"path: {str(p)!r} is a folder, not a chain file")
+    if not p.is_file():
+        raise ValueError(f"path: {str(p)!r} is not a regular file (a FIFO, socket or device)")
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
+        if p.stat().st_size > MAX_FILE_BYTES:
+            raise ValueError(f"path: {str(p)!r} is larger than {MAX_FILE_BYTES // 2**20} MiB, not a chain file")
+        data = tomllib.loads(p.read_text(encoding="utf-8-sig"))
     except UnicodeDecodeError as exc:
         raise ValueError(f"path: {p} is not UTF-8 text: {exc}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"path: {p} is not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ValueError(f"path: {p} is nested too deeply to be a chain file") from None
+    except OSError as exc:
+        raise ValueError(f"path: cannot read {str(p)!r}: {exc.strerror or exc}") from None
     chain = chain_from_dict(data, where=str(p))
-    chain.name = data.get("name", p.stem)
+    name = data.get("name", p.stem)
+    if not isinstance(name, str):
+        raise ValueError(f"{p}: name: expected a string, got {_short(name)}")
+    chain.name = name
     return chain
