@@ -1,4 +1,4 @@
-"""The equation of motion of one A-pair with its legs, by Lagrange's equations (CONVENTIONS.md §4).
+"""The equation of motion of one A-pair with its legs, by Lagrange's equations (docs/conventions.md §4).
 
 Vertical axis, gravity g along −z. The platform (mass m, centre of mass c and inertia I in the
 platform frame) turns by θ and rises by d(θ); each leg is a uniform rod from a fixed base point to

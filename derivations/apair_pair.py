@@ -1,4 +1,4 @@
-"""The A-pair derived from its Griffis-Duffy platform (CONVENTIONS.md §2).
+"""The A-pair derived from its Griffis-Duffy platform (docs/conventions.md §2).
 
 1. The six leg constraints of the GDP as quadrics in the Study parameters, computed from the
    Euclidean sphere condition |R p + t − b|² = L² through the kinematic mapping.

@@ -1,4 +1,4 @@
-"""Equations of motion of nA-chains with leg inertia, n = 1..6 (CONVENTIONS.md §3-§4).
+"""Equations of motion of nA-chains with leg inertia, n = 1..6 (docs/conventions.md §3-§4).
 
 Generalised coordinates: the angles θ. Body j (j ≥ 1) is link j: it carries pair j's platform
 and frame j. The legs of pair i are uniform slender rods from a base point a (on body i−1) to a

@@ -1,4 +1,4 @@
-"""Direct kinematics and geometric Jacobians of nA-chains, n = 1..6 (CONVENTIONS.md §3-§4).
+"""Direct kinematics and geometric Jacobians of nA-chains, n = 1..6 (docs/conventions.md §3-§4).
 
 A_i(θ_i) = Rz(θ_i + φ_i) · Tz(c_i + d_i) · Tx(a_i) · Rx(α_i), each factor built from its elementary
 motion, both as a 4x4 matrix and as a Study point (dual-quaternion product). The joint law enters
@@ -7,7 +7,7 @@ kernels), so one kernel serves R-pairs (d ≡ 0), sinusoidal and general A-pairs
 design parameter is a kernel input.
 
 The chain product is written as a recursion of named steps (frame i = frame i-1 · A_i), so the
-expanded expression is never formed. The Jacobian uses the screw form of CONVENTIONS.md §4 on those
+expanded expression is never formed. The Jacobian uses the screw form of docs/conventions.md §4 on those
 frames; `check_jacobian` proves it equal to the derivative of the forward kinematics
 (chain rule through d_i(θ_i)) at random points in 50-digit arithmetic.
 """

@@ -1,4 +1,4 @@
-"""Quaternions, dual quaternions and Study parameters over sympy (CONVENTIONS.md §1).
+"""Quaternions, dual quaternions and Study parameters over sympy (docs/conventions.md §1).
 
 Only the algebra the derivations need: the Hamilton product, conjugation, and the dual-quaternion
 form of the elementary motions (rotation about an axis through the origin, translation), so that
@@ -64,7 +64,7 @@ class Quaternion:
 
 @dataclass(frozen=True)
 class StudyPoint:
-    """A displacement as the dual quaternion x + ε y, y = ½ t x (CONVENTIONS.md §1)."""
+    """A displacement as the dual quaternion x + ε y, y = ½ t x (docs/conventions.md §1)."""
 
     x: Quaternion
     y: Quaternion

@@ -1,4 +1,4 @@
-"""The derivations against the known results of CONVENTIONS.md §2, and generated/ against them."""
+"""The derivations against the known results of docs/conventions.md §2, and generated/ against them."""
 from __future__ import annotations
 
 import os

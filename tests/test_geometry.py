@@ -55,7 +55,7 @@ def test_leg_lengths_constant_along_the_motion(kind, backend):
 
 
 def test_sinusoidal_pair_facts():
-    """CONVENTIONS.md §2: congruent triangles give L1 = L2 = 3r/2, h = √2 r; d(θ) = h cos(θ/2)."""
+    """docs/conventions.md §2: congruent triangles give L1 = L2 = 3r/2, h = √2 r; d(θ) = h cos(θ/2)."""
     r = 0.7
     p = apair.APair(r, r)
     np.testing.assert_allclose(p.leg_lengths, 1.5 * r, rtol=1e-15)

@@ -1,4 +1,4 @@
-"""`AChain`: a serial chain of R- and A-pairs in the DH convention of CONVENTIONS.md §3.
+"""`AChain`: a serial chain of R- and A-pairs in the DH convention of docs/conventions.md §3.
 
 Joint i: A_i(θ_i) = Rz(θ_i + φ_i) · Tz(c_i + d_i(θ_i)) · Tx(a_i) · Rx(α_i). Each method computes
 the joints' law values with their pairs' kernels and hands everything to one generated chain

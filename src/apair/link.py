@@ -1,4 +1,4 @@
-"""`Link`: the rigid body carrying pair i's platform and frame i (CONVENTIONS.md §4)."""
+"""`Link`: the rigid body carrying pair i's platform and frame i (docs/conventions.md §4)."""
 from __future__ import annotations
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Study parameters: the normalisation used by the runtime (CONVENTIONS.md §1)."""
+"""Study parameters: the normalisation used by the runtime (docs/conventions.md §1)."""
 from __future__ import annotations
 
 import numpy as np
