@@ -60,7 +60,7 @@ def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP
         raise ValueError("t: output times must increase strictly")
     V.scalar("rtol", rtol, positive=True)
     V.scalar("atol", atol, positive=True)
-    if limits not in ("stop", "ignore"):
+    if not isinstance(limits, str) or limits not in ("stop", "ignore"):
         raise ValueError(f"limits: expected 'stop' or 'ignore', got {limits!r}")
     bounds = _bounds(chain, limits)
     for i, (lo, hi) in enumerate(bounds):
