@@ -34,11 +34,18 @@ varieties: install
 install: $(DEPS_STAMP)
 	$(PY) -m pip install --quiet --no-deps --no-build-isolation --force-reinstall .
 
-# The C kernels as a plain shared library, built with the strict flags users may have.
-lib: build/libapair.so
-build/libapair.so: $(wildcard generated/c/*.c generated/c/*.h)
-	mkdir -p build
-	gcc $(CFLAGS_STRICT) -fPIC -shared generated/c/*.c -o $@ -lm
+# The C kernels as a plain shared library, built with the strict flags users may have: one object
+# per generated source, compiled in parallel on every core.
+NPROC := $(shell nproc 2>/dev/null || echo 2)
+C_SOURCES = $(wildcard generated/c/*.c)
+C_OBJECTS = $(patsubst generated/c/%.c,build/obj/%.o,$(C_SOURCES))
+lib:
+	$(MAKE) --no-print-directory -j$(NPROC) build/libapair.so
+build/libapair.so: $(C_OBJECTS)
+	gcc -shared $^ -o $@ -lm
+build/obj/%.o: generated/c/%.c generated/c/apair.h
+	@mkdir -p build/obj
+	gcc $(CFLAGS_STRICT) -fPIC -c $< -o $@
 
 demo: install
 	$(BIN)/apair demo examples/4a_chain.toml

@@ -12,6 +12,7 @@ of one angle into sincos; results are unchanged).
 """
 import hashlib
 import os
+from concurrent.futures import ThreadPoolExecutor
 from glob import glob
 from pathlib import Path
 
@@ -33,6 +34,24 @@ def sources_hash(paths) -> str:
 
 class BuildExt(build_ext):
     """build_ext that says at install time why the C kernels are missing, or skips them on request."""
+
+    def build_extensions(self):
+        """Compile the sources on every core (one file per kernel); setuptools compiles the sources
+        of one extension one after the other."""
+        cc = self.compiler
+        if all(hasattr(cc, f) for f in ("_setup_compile", "_get_cc_args", "_compile")):
+            def compile_parallel(sources, output_dir=None, macros=None, include_dirs=None, debug=0,
+                                 extra_preargs=None, extra_postargs=None, depends=None):
+                macros, objects, extra, pp_opts, build = cc._setup_compile(
+                    output_dir, macros, include_dirs, sources, depends, extra_postargs)
+                cc_args = cc._get_cc_args(pp_opts, debug, extra_preargs)
+                todo = [obj for obj in objects if obj in build]
+                with ThreadPoolExecutor(os.cpu_count() or 1) as pool:
+                    list(pool.map(lambda obj: cc._compile(obj, *build[obj], cc_args, extra, pp_opts), todo))
+                return objects
+
+            cc.compile = compile_parallel
+        super().build_extensions()
 
     def run(self):
         if os.environ.get("APAIR_NO_C"):

@@ -227,10 +227,11 @@ class Emitter:
         files["c/apair_registry.c"] = registry_t.render(
             kernels=sorted(all_kernels, key=lambda k: k.name), prefix=PREFIX, sources=sources,
             hash=content_hash([registry_src] + [fingerprints[k.name] for k in all_kernels]))
-        for stem, ks in lowered.items():
-            c_hash = content_hash([src_src] + [fingerprints[k.name] for k in ks])
-            files[f"c/{stem}.c"] = src_t.render(kernels=ks, source=ks[0].spec.source, hash=c_hash, prefix=PREFIX)
-        c_sources = sorted(["apair_registry.c"] + [f"{stem}.c" for stem in lowered])
+        # one C file per kernel: a program that links the library takes only the kernels it calls
+        for k in all_kernels:
+            c_hash = content_hash([src_src, fingerprints[k.name]])
+            files[f"c/{k.name}.c"] = src_t.render(kernels=[k], source=k.spec.source, hash=c_hash, prefix=PREFIX)
+        c_sources = sorted(["apair_registry.c"] + [f"{k.name}.c" for k in all_kernels])
         # the header's hash covers every C source the binding compiles (so their templates too)
         header_hash = content_hash([header_src, VERSION] + [fingerprints[k.name] for k in all_kernels]
                                    + [files[f"c/{c}"] for c in c_sources])

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 8118403fc1af3232
+Content hash: 9531a14ec32d3534
 """

@@ -283,12 +283,14 @@ def test_cmake_install_serves_find_package_and_pkg_config(cmake, tmp_path):
 def test_driver_detects_a_broken_kernel(driver, tmp_path):
     """The driver's check can fail: a kernel whose batch disagrees with its single call is caught."""
     broken = tmp_path / "broken.c"
-    src = Path(SOURCES[0]).read_text()
+    loop = "for (k = 0; k < count; ++k) {"
+    first = next(s for s in SOURCES if loop in Path(s).read_text())  # a kernel's source
+    src = Path(first).read_text()
     # make the first batch function skip its first item
-    src = src.replace("for (k = 0; k < count; ++k) {", "for (k = 1; k < count; ++k) {", 1)
+    src = src.replace(loop, "for (k = 1; k < count; ++k) {", 1)
     broken.write_text(src)
     exe = tmp_path / "driver_broken"
-    others = [s for s in SOURCES if s != SOURCES[0]]
+    others = [s for s in SOURCES if s != first]
     run(["gcc", "-std=c99", "-O0", f"-I{CDIR}", str(broken), *others, str(driver), "-o", str(exe), "-lm"])
     res = subprocess.run([str(exe)], capture_output=True, text=True)
     assert res.returncode != 0 and "item 0" in res.stdout
@@ -304,3 +306,27 @@ def test_no_allocation_io_or_mutable_state_in_the_library():
         for line in text.splitlines():
             if line.startswith(("static ", "extern ")) or re.match(r"^(double|int|float|char|size_t)\b.*[=;]\s*$", line):
                 assert line.startswith(("static void", "static const", "extern const", "extern \"C\"")), (path, line)
+
+
+def test_a_program_links_only_the_kernels_it_calls(tmp_path):
+    """One source per kernel: a firmware build that calls inverse_dynamics4 from the static library
+    takes that kernel's object alone (not the 1.6 MB of every chain's dynamics)."""
+    program = tmp_path / "id4.c"
+    program.write_text(
+        '#include "apair.h"\nint main(void)\n{\n    double q[4] = {0}, qd[4] = {0}, qdd[4] = {0}, dh[16] = {0}, '
+        "law[12] = {0}, links[40] = {0}, legs[12] = {0}, g[3] = {0, 0, -9.81}, tau[4];\n"
+        "    apair_inverse_dynamics4(q, qd, qdd, dh, law, links, legs, g, tau);\n    return tau[0] != tau[0];\n}\n")
+    objects = tmp_path / "obj"
+    objects.mkdir()
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        list(pool.map(lambda s: run(["gcc", "-std=c99", *STRICT, "-O1", f"-I{CDIR}", "-c", s, "-o",
+                                     str(objects / (Path(s).stem + ".o"))]), SOURCES))
+    archive = tmp_path / "libapair.a"
+    run(["ar", "rcs", str(archive), *sorted(str(p) for p in objects.glob("*.o"))])
+    exe = tmp_path / "id4"
+    run(["gcc", "-std=c99", f"-I{CDIR}", str(program), str(archive), "-lm", "-o", str(exe)])
+    assert subprocess.run([str(exe)]).returncode == 0
+    symbols = run(["nm", str(exe)]).stdout
+    defined = sorted(line.split()[-1] for line in symbols.splitlines() if " T apair_" in line)
+    assert defined == ["apair_inverse_dynamics4", "apair_inverse_dynamics4_batch"]
+    assert exe.stat().st_size < 200_000

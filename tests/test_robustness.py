@@ -104,7 +104,7 @@ def test_content_hash_covers_every_compiled_source():
     files = {p.name: p.read_text() for p in sorted(Path("generated/c").glob("*.[ch]"))}
     manifest = kernels.manifest()
     assert sources_hash(files) == manifest["sources_hash"]
-    edited = dict(files, **{"apair_pair.c": files["apair_pair.c"] + "\n"})
+    edited = dict(files, **{"law_sinusoidal.c": files["law_sinusoidal.c"] + "\n"})
     assert sources_hash(edited) != manifest["sources_hash"]
     if kernels.c_available():
         assert kernels._native()[0].sources_hash == manifest["sources_hash"]
@@ -127,7 +127,7 @@ def test_header_hash_changes_with_the_kernel_template(monkeypatch):
 
     monkeypatch.setattr(E.Emitter, "_template", edited)
     after = E.Emitter().render(lowered, {})
-    assert after["c/apair_pair.c"] != before["c/apair_pair.c"]
+    assert after["c/law_sinusoidal.c"] != before["c/law_sinusoidal.c"]
     assert after["c/apair.h"] != before["c/apair.h"]  # the header (with its hash) follows
     assert E.json.loads(after["manifest.json"])["content_hash"] != E.json.loads(before["manifest.json"])["content_hash"]
 
