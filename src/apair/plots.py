@@ -169,31 +169,30 @@ def segments(chain, q) -> list[tuple[np.ndarray, np.ndarray, str]]:
     return out
 
 
-def _triangles(chain, q) -> list[np.ndarray]:
-    """The plates at q as filled triangles (3, 3): each A-pair's base and platform triangle."""
-    tris = []
-    for a, b, kind in segments(chain, q):
-        if kind == "plate":
-            tris.append(a)
-    return [np.stack(tris[k: k + 3]) for k in range(0, len(tris), 3)]
+def _triangles(segs) -> list[np.ndarray]:
+    """The plates as filled triangles (3, 3) from a chain's segments: each A-pair's base and
+    platform triangle (three edges each, one vertex at the start of each edge)."""
+    starts = [a for a, _, kind in segs if kind == "plate"]
+    return [np.stack(starts[k: k + 3]) for k in range(0, len(starts), 3)]
 
 
-def _draw(ax, chain, q, extent: float):
+def _draw(ax, chain, q, extent: float, segs=None):
     """Links (black), legs (blue, drawn as wide as their real radius where one is given), plates
     (filled orange triangles), the base (square) and the end effector (triangle, with its frame)."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     points_per_m = 72 * 0.8 * ax.figure.get_figwidth() / (2 * extent)  # the axes span about 2·extent
+    segs = segments(chain, q) if segs is None else segs
     legs = [p.leg_radius for p in chain.pairs if p.kind != "revolute" for _ in range(6)]
     k = 0
-    for a, b, kind in segments(chain, q):
+    for a, b, kind in segs:
         if kind == "link":
             ax.plot(*np.stack([a, b]).T, color="k", lw=2.5, solid_capstyle="round")
         elif kind == "leg":
             lw = max(0.8, 2 * legs[k] * points_per_m) if legs[k] > 0 else 1.0
             ax.plot(*np.stack([a, b]).T, color="C0", lw=lw, solid_capstyle="round")
             k += 1
-    tris = _triangles(chain, q)
+    tris = _triangles(segs)
     if tris:
         ax.add_collection3d(Poly3DCollection(tris, facecolor="C1", edgecolor="C1", alpha=0.45, linewidths=1.0))
     T = chain.fk(q)
@@ -229,8 +228,8 @@ def _equal_3d(ax, pts) -> float:
     return r
 
 
-def _scene_points(chain, q) -> np.ndarray:
-    return np.array([x for a, b, _ in segments(chain, q) for x in (a, b)] + [np.zeros(3)])
+def _scene_points(segs) -> np.ndarray:
+    return np.array([x for a, b, _ in segs for x in (a, b)] + [np.zeros(3)])
 
 
 def chain_picture(chain, q, path, overwrite: bool = False) -> Path:
@@ -242,8 +241,9 @@ def chain_picture(chain, q, path, overwrite: bool = False) -> Path:
     plt = _figure()
     fig = plt.figure(figsize=(6, 6))
     ax = fig.add_subplot(projection="3d")
-    extent = _axes_3d(ax, _scene_points(chain, q))
-    _draw(ax, chain, q, extent)
+    segs = segments(chain, q)  # (one fk call per joint: computed once for the limits and the drawing)
+    extent = _axes_3d(ax, _scene_points(segs))
+    _draw(ax, chain, q, extent, segs)
     ax.legend(loc="upper left", fontsize=8)
     ax.set_title(f"{getattr(chain, 'name', '')} at q = {np.round(q, 3).tolist()} rad", fontsize=9)
     _write(p, overwrite, lambda f: fig.savefig(f, dpi=150, format="png", bbox_inches="tight"))
