@@ -59,6 +59,18 @@ class Hoisted:
     stored: list[str]
     core_inputs: list[tuple[Arg, list[tuple[int, str]]]]
     core: list[tuple[str, str]]
+    core_ops: int  # operations per item of a batch that shares its design
+
+
+@dataclass
+class LoweredCall:
+    """A callee of a composite kernel: its name, the caller's argument for each of its inputs
+    (None: zeros), its output's shape, and the (index, name) of each result entry the caller uses."""
+
+    kernel: str
+    args: list[tuple[str | None, Arg]]
+    out: Arg
+    results: list[tuple[int, str]]
 
 
 @dataclass
@@ -72,6 +84,7 @@ class Lowered:
     ops: int
     fingerprint: str
     hoisted: Hoisted | None  # None: nothing depends on design inputs alone
+    calls: list[LoweredCall]  # kernels evaluated first (their own hoisting applies); then no `hoisted`
 
     @property
     def name(self) -> str:
@@ -113,16 +126,17 @@ def _hoist(spec: KernelSpec, local: dict, assignments, reduced, printed: dict) -
     used_inv = set().union(*(e.free_symbols for _, e in inv))
     return Hoisted(_slots(spec.inputs, local, used_inv), [(str(s), printed[s]) for s, _ in inv],
                    [str(s) for s in stored], _slots(spec.inputs, local, needed),
-                   [(str(s), printed[s]) for s, _ in core])
+                   [(str(s), printed[s]) for s, _ in core],
+                   int(sp.count_ops([e for _, e in core] + [sp.S(e) for e in reduced])))
 
 
 def lower(spec: KernelSpec) -> Lowered:
     """Straight-line code for a spec: its steps and outputs after CSE, in dependency order.
 
-    The steps are kept as named assignments (they are the derivation's own common subexpressions,
-    so a recursion stays linear in size); CSE runs over the step expressions and outputs with the
-    step symbols free, and the CSE temporaries are then placed just before their first use. Steps
-    that no output needs are dropped.
+    The steps are kept as assignments (they are the derivation's own common subexpressions, so a
+    recursion stays linear in size); CSE runs over the step expressions and outputs with the step
+    symbols free, and the CSE temporaries are then placed just before their first use. Steps that
+    no output needs are dropped, and all intermediates are renamed t0, t1, ... in order.
     """
     arrays = {a.name for a in spec.inputs + spec.outputs}
     local = {}  # a scalar named like an array argument is renamed, e.g. theta -> theta_v
@@ -132,6 +146,10 @@ def lower(spec: KernelSpec) -> Lowered:
                 local[s] = sp.Symbol(f"{s}_v", real=True)
             if str(s).startswith("t") and str(s)[1:].isdigit():
                 raise ValueError(f"{spec.name}: input symbol {s} clashes with CSE temporaries")
+    for c in spec.calls:
+        for r in c.results:
+            if str(r).startswith("t") and str(r)[1:].isdigit() or str(r) in arrays:
+                raise ValueError(f"{spec.name}: result symbol {r} clashes with a temporary or an argument")
     outputs = [sp.S(e).xreplace(local) for a in spec.outputs for e in a.exprs]
     needed = set().union(*(e.free_symbols for e in outputs)) if outputs else set()
     steps = []
@@ -145,6 +163,26 @@ def lower(spec: KernelSpec) -> Lowered:
     replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), order="canonical")
     assignments = _ordered(replacements, [(s, e) for (s, _), e in zip(steps, reduced[: len(steps)])])
     reduced = reduced[len(steps):]
+    # a step that is only another name (of a symbol or a number) is substituted away
+    alias, kept = {}, []
+    for s, e in assignments:
+        e = e.xreplace(alias) if alias else e
+        if e.is_Symbol or e.is_Number:
+            alias[s] = e
+        else:
+            kept.append((s, e))
+    reduced = [sp.S(e).xreplace(alias) for e in reduced]
+    live = set().union(*(sp.S(e).free_symbols for e in reduced)) if reduced else set()
+    assignments = []
+    for s, e in reversed(kept):  # and what nothing uses any more is dropped
+        if s in live:
+            assignments.append((s, e))
+            live |= e.free_symbols
+    assignments.reverse()
+    # every intermediate becomes t0, t1, ... in order of definition: short lines, small sources
+    rename = {s: sp.Symbol(f"t{k}", real=True) for k, (s, _) in enumerate(assignments)}
+    assignments = [(rename[s], e.xreplace(rename)) for s, e in assignments]
+    reduced = [sp.S(e).xreplace(rename) for e in reduced]
     used = set()
     for _, e in assignments:
         used |= e.free_symbols
@@ -162,8 +200,17 @@ def lower(spec: KernelSpec) -> Lowered:
             for target, p in PRINTERS.items()}
     signature = Signature(spec.name, spec.doc, spec.source, [_bare(a) for a in spec.inputs],
                           [_bare(a) for a in spec.outputs])
-    return Lowered(signature, inputs, code["c"], code["py"], ops, spec.fingerprint(),
-                   _hoist(spec, local, assignments, reduced, printed["c"]))
+    calls = [LoweredCall(c.kernel.name, [(name, _bare(a)) for name, a in zip(c.args, c.kernel.inputs)],
+                         _bare(c.kernel.outputs[0]), [(i, str(r)) for i, r in enumerate(c.results) if r in used])
+             for c in spec.calls]
+    for c, call in zip(spec.calls, calls):
+        if c.kernel.source != spec.source:
+            raise ValueError(f"{spec.name}: calls {c.kernel.name} from another derivation")
+        for name, a in call.args:
+            if a.design and name is None:
+                raise ValueError(f"{spec.name}: {c.kernel.name}'s design input {a.name} cannot be zeros")
+    hoisted = None if calls else _hoist(spec, local, assignments, reduced, printed["c"])
+    return Lowered(signature, inputs, code["c"], code["py"], ops, spec.fingerprint(), hoisted, calls)
 
 
 def _ordered(replacements, steps):
@@ -228,13 +275,24 @@ class Emitter:
             kernels=sorted(all_kernels, key=lambda k: k.name), prefix=PREFIX, sources=sources,
             hash=content_hash([registry_src] + [fingerprints[k.name] for k in all_kernels]))
         # one C file per kernel: a program that links the library takes only the kernels it calls
+        by_name = {k.name: k for k in all_kernels}
+        called = sorted({c.kernel for k in all_kernels for c in k.calls})
+        for name in called:
+            if by_name[name].hoisted is None:
+                raise ValueError(f"{name} is called by another kernel but has no design-only part to share")
+        internal_t, internal_src = self._template("apair_internal.h.j2")
+        files["c/apair_internal.h"] = internal_t.render(
+            kernels=[by_name[c] for c in called], prefix=PREFIX,
+            sources=sorted({by_name[c].spec.source for c in called}) or ["no derivation (no kernel calls another)"],
+            hash=content_hash([internal_src] + [fingerprints[c] for c in called]))
         for k in all_kernels:
-            c_hash = content_hash([src_src, fingerprints[k.name]])
-            files[f"c/{k.name}.c"] = src_t.render(kernels=[k], source=k.spec.source, hash=c_hash, prefix=PREFIX)
+            c_hash = content_hash([src_src, fingerprints[k.name]] + [fingerprints[c.kernel] for c in k.calls])
+            files[f"c/{k.name}.c"] = src_t.render(kernels=[k], source=k.spec.source, hash=c_hash, prefix=PREFIX,
+                                                  by_name=by_name, called=called)
         c_sources = sorted(["apair_registry.c"] + [f"{k.name}.c" for k in all_kernels])
         # the header's hash covers every C source the binding compiles (so their templates too)
         header_hash = content_hash([header_src, VERSION] + [fingerprints[k.name] for k in all_kernels]
-                                   + [files[f"c/{c}"] for c in c_sources])
+                                   + [files[f"c/{c}"] for c in c_sources] + [files["c/apair_internal.h"]])
         files["c/apair.h"] = header_t.render(kernels=all_kernels, hash=header_hash, sources=sources, prefix=PREFIX,
                                              version=VERSION)
         for name in ("CMakeLists.txt", "apair.pc.in"):

@@ -160,6 +160,7 @@ def derive():
 
     # --- laws and their derivatives, for the kernels ---------------------------------------------
     laws = {
+        "revolute": (sp.S(0), (theta,)),
         "sinusoidal": (d_sinus, (theta, h)),
         "general": (d_general, (theta, a, b)),
     }
@@ -221,20 +222,65 @@ def derive():
 
 
 def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
-    """Kernel: (θ, pair constants) -> (d, d', d'') of one pair, differentiated symbolically."""
+    """Kernel: (θ, pair constants) -> (cos(θ/2), sin(θ/2), d, d', d'') of one pair.
+
+    d, d', d'' are differentiated symbolically in θ and then written in C = cos(θ/2), S = sin(θ/2)
+    (θ = 2u, expand_trig), so the kernel makes one sincos-able pair of calls and the chain kernels
+    none: they take cos θ = C² − S², sin θ = 2CS. For the general pair d² = a + b(C² − S²) is
+    formed in that order, which `APair.theta_limit` repeats in Python to find the last double of
+    the range.
+    """
     names = {theta: "theta", h: "h", a: "a", b: "b"}
     inputs = [Arg(names[s], (1,), doc, (s,)) for s, doc in zip(args, {
+        "revolute": ["joint angle [rad]"],
         "sinusoidal": ["joint angle [rad]", "amplitude h = sqrt(2 r_b r_p) [m]"],
         "general": ["joint angle [rad], a + b cos(theta) >= 0", "pair constant a [m^2]", "pair constant b = r_b r_p [m^2]"],
     }[kind])]
+    u = sp.Symbol("u", real=True)
+    C, S = sp.Symbol("C_half", real=True), sp.Symbol("S_half", real=True)
+    cos_t = sp.Symbol("cos_theta", real=True)
+
+    def in_half(e):
+        e = sp.expand_trig(sp.simplify(e).subs(theta, 2 * u))
+        e = e.subs({sp.cos(u): C, sp.sin(u): S})
+        assert e.free_symbols <= {C, S, h, a, b}, e
+        return e
+
     derivs = [d_expr, sp.diff(d_expr, theta), sp.diff(d_expr, theta, 2)]
-    derivs = [sp.simplify(e) for e in derivs]
+    steps = [(C, sp.cos(theta / 2)), (S, sp.sin(theta / 2))]
+    if kind == "general":
+        # d = √(a + b cos θ): keep the radicand as one step so that d, d', d'' share it
+        gap = sp.Symbol("gap", real=True)
+        steps += [(cos_t, C**2 - S**2), (gap, a + b * cos_t)]
+        dsym = sp.Symbol("d_general", real=True)
+        steps.append((dsym, sp.sqrt(gap)))
+        radicand = a + b * sp.cos(theta)
+        outs = []
+        for e in derivs:
+            e = sp.simplify(e).subs(sp.sqrt(radicand), dsym)
+            e = sp.expand_trig(e.subs(theta, 2 * u)).subs({sp.cos(u): C, sp.sin(u): S})
+            outs.append(sp.factor(e))
+        for e in outs:
+            assert e.free_symbols <= {C, S, dsym, a, b}, e
+        # the same values on the angle route, at a random point
+        vals = {theta: sp.Rational(7, 10), a: sp.Rational(3, 10), b: sp.Rational(11, 10)}
+        env = {C: sp.cos(vals[theta] / 2), S: sp.sin(vals[theta] / 2)}
+        env[dsym] = sp.sqrt(vals[a] + vals[b] * (env[C]**2 - env[S]**2))
+        for e, ref in zip(outs, derivs):
+            assert abs(sp.N(e.subs(env).subs(vals) - ref.subs(vals), 30)) < 1e-25
+    elif kind == "revolute":
+        outs = [sp.S(0), sp.S(0), sp.S(0)]
+    else:
+        outs = [sp.factor(in_half(e)) for e in derivs]
     return KernelSpec(
         name=f"law_{kind}",
-        doc=f"The {kind} A-pair's translation d(theta) and its first two derivatives.",
+        doc=(f"The {kind} pair's law values at theta: cos(theta/2), sin(theta/2), d(theta) and its first two "
+             "derivatives, as the chain kernels take them."),
         source=SOURCE,
         inputs=inputs,
-        outputs=[Arg("law", (3,), "(d [m], d' [m/rad], d'' [m/rad^2])", exprs=tuple(derivs))],
+        outputs=[Arg("law", (5,), "(cos(theta/2), sin(theta/2), d [m], d' [m/rad], d'' [m/rad^2])",
+                     exprs=(C, S) + tuple(outs))],
+        steps=steps,
     )
 
 

@@ -1,22 +1,29 @@
 """Equations of motion of nA-chains with leg inertia, n = 1..6 (docs/conventions.md §3-§4).
 
-Generalised coordinates: the angles θ. Body j (j ≥ 1) is link j: it carries pair j's platform
-and frame j. The legs of pair i are uniform slender rods from a base point a (on body i−1) to a
-platform point b (on body i); a rod's kinetic energy (m/6)(|v_a|² + v_a·v_b + |v_b|²) is a point
-mass m/3 at each end plus the coupling (m/6) v_a·v_b, and its potential energy is that of m/2 at
-each end. Everything is assembled in the base frame from spatial quantities referred to the base
-origin, so each term needs only the moments of a pair's leg end points, derived from the platform
-geometry (derivations/apair_pair.py):
+Generalised coordinates: the angles θ, entering through each joint's law values (cos(θ/2),
+sin(θ/2), d, d', d''). Body j (j ≥ 1) is link j: it carries pair j's platform and frame j.
 
-    T = ½ Σ_j V_jᵀ 𝕄_j V_j + Σ_i V_{i−1}ᵀ X_i V_i,   V_j = Σ_{k ≤ j} S_k θ'_k,
-    S_k = (z_{k−1}, o_{k−1} × z_{k−1} + d'_k z_{k−1})   (the joint screw, pitch d'_k),
+Everything is computed in local link frames (Featherstone's formulation). Body i's coordinates are
+Q_i = frame_{i-1} · Rz(θ_i + φ_i) · Tz(c_i + d_i): its origin lies on joint i's axis, so the joint
+is a screw along z with the angle-dependent pitch d'_i, S_i = (e_z, d'_i e_z), and frame i is the
+constant Q_i · Tx(a_i) Rx(α_i). Parent to child is then four elementary motions (derivations/
+spatial.py). The legs of pair i are uniform slender rods from base points a (on body i−1, in pair
+i's base frame B_i = frame i−1, Σa = 0) to platform points b (on body i, b = Rz(θ_i) p + d_i e_z,
+Σp = 0): a rod's kinetic energy (m/6)(|v_a|² + v_a·v_b + |v_b|²) is a point mass m/3 at each end
+(folded into the bodies' constant inertias) plus the coupling (m/6) v_a·v_b, which needs only
+K = Σ a bᵀ = Σ a pᵀ Rz(θ_i)ᵀ and Σb = 6 d_i e_z. In B_i the coupling is
+(m/6) V_{i−1}ᵀ X V_i with X = [[tr K·1 − Kᵀ, 0], [−6 d_i [e_z]×, 6·1]], V_i = V_{i−1} + S_i θ'_i:
+body i−1 carries the extra rigid-body inertia (m/3)·sym X = (2m, m d_i e_z, (m/3)(tr K·1 − sym K))
+and column i of M the extra force (m/6) X S_i on body i−1.
 
-so M_kl = S_kᵀ 𝕄^c_{max(k,l)} S_l + S_kᵀ Y_{max(k+1,l)} S_l + S_lᵀ Y_{max(l+1,k)} S_k with composite
-sums 𝕄^c_j = Σ_{j'≥j} 𝕄_j', Y_m = Σ_{i≥m} X_i (a CRBA with leg couplings). The inverse dynamics,
-bias and gravity torques come from a Newton-Euler recursion with the same bodies and leg couplings
-(`rnea`), and C from the Christoffel symbols of M by forward-mode differentiation of these steps
-(derivations/autodiff.py), with d/dθ_k of the law values (d, d', d'') → (d', d'', ·). `check_bias`
-proves the recursion equal to the Lagrangian Ṁθ' − ∇(T − V) at random points.
+- `Assembly`: the mass matrix by the composite-rigid-body algorithm with those two leg terms,
+  and the potential energy (half of each rod's weight at each end) by a gravity recursion;
+- `rnea`: inverse dynamics, bias and gravity torques by recursive Newton-Euler, each leg of pair i
+  pushing body i at b with (m/6) times the acceleration of a and body i−1 at a with (m/6) times
+  that of b (gravity as the base acceleration, so each end carries m/2 of the rod's weight);
+- `christoffel`: C = ½(Ṁ + W − Wᵀ) by forward-mode differentiation of these steps;
+- `check_bias`: at generation time, the recursion equals the Lagrangian Ṁθ' − ∇(T − V) with
+  T = ½ θ'ᵀMθ', the gravity torques equal ∂V/∂θ, and the recursion at θ' = 0 gives M θ''.
 """
 from __future__ import annotations
 
@@ -24,12 +31,16 @@ import sympy as sp
 
 from . import apair_pair
 from .autodiff import directional, gradient
-from .chain_kinematics import MAX_N, _Recorder, chain_inputs, frames
-from .spec import Arg, KernelSpec
+from .chain_kinematics import MAX_N, _Recorder, chain_inputs, joint_trig
+from .spatial import (Namer, add_inertia, apply_inertia, cross_force, cross_motion, force_to_parent,
+                      inertia_to_parent, motion_to_child, point_mass_inertia, rotation, skew)
+from .spec import Arg, Call, KernelSpec
 
 SOURCE = "derivations/chain_dynamics.py"
 LINK_FIELDS = ("m", "cx", "cy", "cz", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")
 LEG_FIELDS = ("ml", "rb", "rp")
+EZ = sp.Matrix([0, 0, 1])
+ZERO3 = sp.zeros(3, 1)
 
 
 def leg_moments():
@@ -38,7 +49,7 @@ def leg_moments():
     Returns (Σ a aᵀ, Σ p pᵀ, Σ a pᵀ): base points a in the base frame, platform points p in the
     platform frame, paired leg by leg. Asserts the first moments Σ a, Σ p vanish (both point sets
     are symmetric about the axis) and that the second moments are invariant under Rz, which is
-    what lets the assembly below use them in any frame with the same z axis.
+    what lets the bodies take them in any frame with the same z axis.
     """
     legs = apair_pair.legs()
     A = [sp.Matrix(a) for a, _, _ in legs]
@@ -57,18 +68,17 @@ def leg_moments():
 
 
 def dynamics_inputs(n: int):
-    """theta, qd, qdd, dh, law, links (n, 10), legs (n, 3), gravity (3) and their symbols."""
+    """law, qd, qdd, dh, links (n, 10), legs (n, 3), gravity (3) and their symbols."""
     kin, J = chain_inputs(n)
-    theta, dh, law = kin
+    law, dh = kin
     for i, j in enumerate(J, start=1):
         j.update({k: sp.Symbol(f"{k}_{i}", real=True) for k in ("qd", "qdd") + LINK_FIELDS + LEG_FIELDS})
     gvec = sp.symbols("g_x g_y g_z", real=True)
     args = {
-        "theta": theta,
+        "law": law,
         "qd": Arg("qd", (n,), "joint velocities theta'_i [rad/s]", tuple(j["qd"] for j in J)),
         "qdd": Arg("qdd", (n,), "joint accelerations theta''_i [rad/s^2]", tuple(j["qdd"] for j in J)),
         "dh": dh,
-        "law": law,
         "links": Arg("links", (n, 10), "per link (mass [kg], com [m] in frame i (3), inertia about the com in "
                      "frame i: Ixx, Iyy, Izz, Ixy, Ixz, Iyz [kg m^2])", tuple(j[k] for j in J for k in LINK_FIELDS),
                      design=True),
@@ -79,131 +89,110 @@ def dynamics_inputs(n: int):
     return args, J, sp.Matrix(gvec)
 
 
-def _skew(v):
-    return sp.Matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+def _vee_antisym(N):
+    """Σ_k a_k × c_k from N = Σ_k a_k c_kᵀ."""
+    return sp.Matrix([N[1, 2] - N[2, 1], N[2, 0] - N[0, 2], N[0, 1] - N[1, 0]])
 
 
 class Assembly:
-    """The recorded computation of M(θ) and V(θ) for one chain length."""
+    """The recorded computation of M(θ) and V(θ) for one chain length, and what the recursions share:
+    the frame chains, joint screws, body inertias and leg terms."""
 
     def __init__(self, n: int):
         self.n = n
         self.args, self.J, self.g = dynamics_inputs(n)
         self.rec = rec = _Recorder()
-        F = frames(n, self.J, rec)
+        nm = Namer(rec, "")
         Saa, Spp, Sap, (rb0, rp0) = leg_moments()
-        vec = lambda label, v: sp.Matrix([rec.name(f"{label}_{k}", sp.expand(v[k])) for k in range(3)])
-        z = [F[k][:3, 2] for k in range(n + 1)]
-        o = [F[k][:3, 3] for k in range(n + 1)]
-        R = [F[k][:3, :3] for k in range(n + 1)]
+        local = lambda S, j: S.subs({rb0: j["rb"], rp0: j["rp"]})
+        J = self.J
+        # frame chains: B_i -> Q_i ("inner", moves with joint i) and Q_i -> frame i = B_{i+1} ("outer")
+        self.inner, self.outer, self.K = {}, {}, {}
+        for i, j in enumerate(J, start=1):
+            ct, st, cq, sq = joint_trig(j, rec, f"{i}")
+            self.inner[i] = [("rz", cq, sq), ("tz", j["c"] + j["d"])]
+            self.outer[i] = [("tx", j["a"]), ("rx", sp.cos(j["alpha"]), sp.sin(j["alpha"]))]
+            # K = Σ a bᵀ of pair i in B_i: b = Rz(θ) p + d e_z and Σ a = 0
+            self.K[i] = nm.mat3("K", local(Sap, j) * rotation("z", ct, st).T)
+        # body inertias in Q_i (design constants): link i (given in frame i) and the m/3 point
+        # masses of pair i+1's base ends (in frame i) moved through Q_i -> frame i; pair i's
+        # platform ends in P_i = Q_i · Tz(−c_i) · Rz(−φ_i) (the Rz leaves their moments unchanged)
+        self.bodies, self.weights = [], []
+        for i, j in enumerate(J, start=1):
+            c = sp.Matrix([j["cx"], j["cy"], j["cz"]])
+            Ic = sp.Matrix([[j["Ixx"], j["Ixy"], j["Ixz"]], [j["Ixy"], j["Iyy"], j["Iyz"]], [j["Ixz"], j["Iyz"], j["Izz"]]])
+            link = (j["m"], j["m"] * c, Ic + j["m"] * ((c.T * c)[0] * sp.eye(3) - c * c.T))
+            parts_i, weight_i = [link], [(j["m"], j["m"] * c, None)]
+            if i < n:
+                nxt = J[i]
+                parts_i.append(point_mass_inertia(2 * nxt["ml"], ZERO3, nxt["ml"] / 3 * local(Saa, nxt)))
+                weight_i.append((3 * nxt["ml"], ZERO3, None))
+            in_frame = add_inertia(*parts_i)
+            body = inertia_to_parent(self.outer[i], in_frame, nm, "Ib")
+            plat = inertia_to_parent([("tz", -j["c"])], point_mass_inertia(2 * j["ml"], ZERO3, j["ml"] / 3 * local(Spp, j)),
+                                     nm, "Ip")
+            self.bodies.append(self._named(nm, "B", add_inertia(body, plat)))
+            wm = sum((w[0] for w in weight_i), sp.S(0))
+            wh = sum((w[1] for w in weight_i), sp.zeros(3, 1))
+            _, wh, _ = inertia_to_parent(self.outer[i], (wm, wh, None), nm, "Wh")
+            _, ph, _ = inertia_to_parent([("tz", -j["c"])], (3 * j["ml"], ZERO3, None), nm, "Wp")
+            self.weights.append((rec.name(f"Wm{i}", wm + 3 * j["ml"]), nm.vec("W", wh + ph)))
+        # joint screws and the leg terms of pair i ≥ 2 (on body i−1, in B_i)
+        self.S = [(EZ, j["dd"] * EZ) for j in J]
+        self.coupling, self.cross = {}, {}
+        for i in range(2, n + 1):
+            j, K = J[i - 1], self.K[i]
+            ml, trK = j["ml"], K.trace()
+            self.coupling[i] = (2 * ml, ml * j["d"] * EZ, nm.sym3("Xs", ml / 3 * (trK * sp.eye(3) - (K + K.T) / 2)))
+            self.cross[i] = (ml / 6 * (trK * sp.eye(3) - K.T) * EZ, ml * j["dd"] * EZ)
 
-        # joint screws S_k = (w, v)
-        self.S = []
-        for k, j in enumerate(self.J, start=1):
-            w = z[k - 1]
-            v = vec(f"Sv{k}", o[k - 1].cross(w) + j["dd"] * w)
-            self.S.append((w, v))
-
-        def local(S, j):
-            return S.subs({rb0: j["rb"], rp0: j["rp"]})
-
-        # body spatial inertias about the base origin: (Θ 3x3, h 3, μ)
-        bodies, oPs = [], {}
-        self.bodies = bodies
-        first_moment = sp.zeros(3, 1)  # Σ mass · position, for the potential energy
-        for jx, j in enumerate(self.J, start=1):
-            c = vec(f"com{jx}", o[jx] + R[jx] * sp.Matrix([j["cx"], j["cy"], j["cz"]]))
-            I_loc = sp.Matrix([[j["Ixx"], j["Ixy"], j["Ixz"]], [j["Ixy"], j["Iyy"], j["Iyz"]], [j["Ixz"], j["Iyz"], j["Izz"]]])
-            Theta = R[jx] * I_loc * R[jx].T + j["m"] * ((c.T * c)[0] * sp.eye(3) - c * c.T)
-            h = j["m"] * c
-            mu = j["m"]
-            first_moment += j["m"] * c
-            # platform ends of pair jx (on body jx): centre o_P = o_{jx-1} + d z_{jx-1}
-            oP = oPs[jx] = vec(f"oP{jx}", o[jx - 1] + j["d"] * z[jx - 1])
-            pts = [(oP, R[jx - 1] * local(Spp, j) * R[jx - 1].T, j["ml"])]
-            # base ends of pair jx+1 (on body jx): centre o_jx
-            if jx < n:
-                nxt = self.J[jx]
-                pts.append((o[jx], R[jx] * local(Saa, nxt) * R[jx].T, nxt["ml"]))
-            for centre, second, ml in pts:
-                # six points of mass ml/3 each: Σ p = 6 centre (first moments vanish locally)
-                sum_ppT = 6 * centre * centre.T + second
-                Theta += ml / 3 * (sum_ppT.trace() * sp.eye(3) - sum_ppT)
-                h += ml / 3 * 6 * centre
-                mu += 2 * ml
-            bodies.append(self._name_inertia(f"B{jx}", Theta, h, mu))
-        # the potential energy: links, and half of each leg's mass at each of its ends
-        for i, j in enumerate(self.J, start=1):
-            oP = oPs[i]
-            first_moment += j["ml"] / 2 * (6 * o[i - 1] + 6 * oP)
-        self.V = -(self.g.T * first_moment)[0]
-
-        # leg couplings X_i between bodies i-1 and i (i ≥ 2); K_i = Σ a bᵀ also serves the RNEA
-        X, self.legsum = {}, {}
-        for i in range(1, n + 1):
-            j = self.J[i - 1]
-            oP = oPs[i]
-            Rz = sp.Matrix([[sp.cos(j["theta"]), -sp.sin(j["theta"]), 0], [sp.sin(j["theta"]), sp.cos(j["theta"]), 0], [0, 0, 1]])
-            # K = Σ a bᵀ with a = o + R α, b = o_P + R Rz p, Σα = Σp = 0
-            K = 6 * o[i - 1] * oP.T + R[i - 1] * local(Sap, j) * Rz.T * R[i - 1].T
-            K = sp.Matrix(3, 3, [rec.name(f"K{i}_{r}{c}", sp.expand(K[r, c])) for r in range(3) for c in range(3)])
-            A, B = 6 * o[i - 1], 6 * oP
-            self.legsum[i] = (A, B, K, j["ml"])
-            if i == 1:
-                continue  # body 0 does not move: no kinetic coupling
-            top = (-(K.T - K.trace() * sp.eye(3))).row_join(_skew(A))
-            bottom = (-_skew(B)).row_join(6 * sp.eye(3))
-            X[i] = (j["ml"] / 6) * top.col_join(bottom)
-
-        # composite sums and the mass matrix
-        comp = [None] * (n + 2)
-        acc = None
-        for jx in range(n, 0, -1):
-            Th, h, mu = bodies[jx - 1]
-            acc = (Th, h, mu) if acc is None else self._name_inertia(f"C{jx}", acc[0] + Th, acc[1] + h, acc[2] + mu)
-            comp[jx] = acc
-        Y = [None] * (n + 2)
-        accY = None
-        for m in range(n, 1, -1):
-            accY = X[m] if accY is None else accY + X[m]
-            accY = sp.Matrix(6, 6, [rec.name(f"Y{m}_{r}{c}", sp.expand(accY[r, c])) for r in range(6) for c in range(6)])
-            Y[m] = accY
-        # M_kl = S_k · F, F = (𝕄^c_l + Y_l + Y_{l+1}ᵀ) S_l for k < l and (𝕄^c_l + Y_{l+1} + Y_{l+1}ᵀ) S_l for k = l
-        zero6 = sp.zeros(6, 6)
-        Yof = lambda m: Y[max(m, 2)] if max(m, 2) <= n else zero6  # Y_1 = Y_2: body 0 does not move
+        # composite-rigid-body algorithm
+        Ic = {n: self.bodies[n - 1]}
+        for i in range(n, 1, -1):
+            IB = inertia_to_parent(self.inner[i], Ic[i], nm, "Ci")
+            IB = self._named(nm, "CB", add_inertia(IB, self.coupling[i]))
+            Ic[i - 1] = self._named(nm, "Cc", add_inertia(self.bodies[i - 2], inertia_to_parent(self.outer[i - 1], IB, nm, "Co")))
         M = sp.zeros(n, n)
-        for l in range(1, n + 1):
-            Sl = self._col(l)
-            base = self._spatial(comp[l])
-            off = base + Yof(l) + Yof(l + 1).T
-            diag = base + Yof(l + 1) + Yof(l + 1).T
-            F_off = sp.Matrix([rec.name(f"F{l}_{r}", sp.expand(v)) for r, v in enumerate(off * Sl)])
-            F_diag = sp.Matrix([rec.name(f"Fd{l}_{r}", sp.expand(v)) for r, v in enumerate(diag * Sl)])
-            for k in range(1, l + 1):
-                e = (self._col(k).T * (F_diag if k == l else F_off))[0]
-                M[k - 1, l - 1] = M[l - 1, k - 1] = rec.name(f"M{k}{l}", e)
+        for i in range(1, n + 1):
+            F = [nm.vec("Fn", x) for x in apply_inertia(Ic[i], self.S[i - 1])]
+            M[i - 1, i - 1] = rec.name(f"M{i}{i}", self._project(i, F))
+            if i == 1:
+                continue
+            FB = force_to_parent(self.inner[i], F, nm, "Fb")
+            FB = [nm.vec("Fg", FB[0] + self.cross[i][0]), nm.vec("Fg", FB[1] + self.cross[i][1])]
+            for k in range(i - 1, 0, -1):
+                F = force_to_parent(self.outer[k], FB, nm, "Fo")
+                M[k - 1, i - 1] = M[i - 1, k - 1] = rec.name(f"M{k}{i}", self._project(k, F))
+                if k > 1:
+                    FB = force_to_parent(self.inner[k], F, nm, "Fb")
         self.M = M
-        self.z = z
 
-    def _name_inertia(self, label, Theta, h, mu):
-        rec = self.rec
-        Th = sp.zeros(3, 3)
-        for r in range(3):
-            for c in range(r, 3):
-                Th[r, c] = Th[c, r] = rec.name(f"{label}T{r}{c}", sp.expand(Theta[r, c]))
-        hh = sp.Matrix([rec.name(f"{label}h{k}", sp.expand(h[k])) for k in range(3)])
-        return Th, hh, rec.name(f"{label}m", sp.expand(mu))
+        # the potential energy (its own steps: they need the gravity input): gravity in body
+        # coordinates and g·o_i along the chain
+        self.vrec = vrec = _Recorder()
+        nm = Namer(vrec, "")
+        gv, g_dot_o, V = self.g, sp.S(0), sp.S(0)
+        for i in range(1, n + 1):
+            chain = (self.outer[i - 1] if i > 1 else []) + self.inner[i]
+            for e in chain:
+                if e[0] in ("rx", "rz"):
+                    gv = nm.vec("gv", rotation(e[0][1], e[1], e[2]).T * gv)
+                else:
+                    g_dot_o = vrec.name(f"go{i}_{e[0]}", sp.expand(g_dot_o + e[1] * gv[{"tx": 0, "tz": 2}[e[0]]]))
+            wm, wh = self.weights[i - 1]
+            V = V - wm * g_dot_o - (gv.T * wh)[0]
+        self.V = vrec.name("Vpot", sp.expand(V))
 
-    def _spatial(self, inertia):
-        Th, h, mu = inertia
-        return Th.row_join(_skew(h)).col_join(_skew(h).T.row_join(mu * sp.eye(3)))
+    def _named(self, nm, tag, inertia):
+        m, h, Ib = inertia
+        return self.rec.name(f"{tag}{nm.count + 1}m", sp.expand(m)), nm.vec(tag + "h", h), nm.sym3(tag, Ib)
 
-    def _col(self, k):
-        w, v = self.S[k - 1]
-        return w.col_join(v)
+    def _project(self, k, F):
+        """S_kᵀ F for a force F = (n, f) in Q_k: n_z + d'_k f_z."""
+        return F[0][2] + self.J[k - 1]["dd"] * F[1][2]
 
     def velocity_tangent(self) -> dict:
-        """d/dt of the inputs along the motion: θ_k → θ'_k, d_k → d'_k θ'_k, d'_k → d''_k θ'_k."""
+        """d/dt of the inputs along the motion: Σ_k θ'_k d/dθ_k."""
         tangent = {}
         for k, j in enumerate(self.J, start=1):
             for s, v in self.seeds(k).items():
@@ -211,84 +200,94 @@ class Assembly:
         return tangent
 
     def seeds(self, k: int) -> dict:
-        """d/dθ_k of the inputs: θ_k → 1 and, through the law, d_k → d'_k, d'_k → d''_k."""
+        """d/dθ_k of the inputs: cos(θ/2) → −sin(θ/2)/2, sin(θ/2) → cos(θ/2)/2 and, through the
+        law, d → d', d' → d''."""
         j = self.J[k - 1]
-        return {j["theta"]: 1, j["d"]: j["dd"], j["dd"]: j["ddd"]}
+        return {j["ch"]: -j["sh"] / 2, j["sh"]: j["ch"] / 2, j["d"]: j["dd"], j["dd"]: j["ddd"]}
 
     def inputs(self, *names):
         return [self.args[nm] for nm in names]
 
 
 def _through_law(asm: Assembly, grads: dict, k: int) -> sp.Expr:
-    """d/dθ_k from partial derivatives: ∂/∂θ_k + d'_k ∂/∂d_k + d''_k ∂/∂d'_k."""
+    """d/dθ_k from partial derivatives: Σ_s ∂/∂s · ds/dθ_k over the seeds of joint k."""
     return sum((grads.get(s, 0) * v for s, v in asm.seeds(k).items()), sp.S(0))
-
-
-def _cross_m(V, S):
-    """Motion cross product (ω, v) ×m (w, u) = (ω × w, ω × u + v × w)."""
-    w, v = V[:3, 0], V[3:, 0]
-    return w.cross(S[:3, 0]).col_join(w.cross(S[3:, 0]) + v.cross(S[:3, 0]))
-
-
-def _cross_f(V, F):
-    """Force cross product (ω, v) ×f (n, f) = (ω × n + v × f, ω × f)."""
-    w, v = V[:3, 0], V[3:, 0]
-    return (w.cross(F[:3, 0]) + v.cross(F[3:, 0])).col_join(w.cross(F[3:, 0]))
-
-
-def _vee_antisym(N):
-    """Σ_k a_k × c_k from N = Σ_k a_k c_kᵀ."""
-    return sp.Matrix([N[1, 2] - N[2, 1], N[2, 0] - N[0, 2], N[0, 1] - N[1, 0]])
 
 
 def rnea(asm: Assembly, qd, qdd, gravity: bool, prefix: str):
     """Recursive Newton-Euler with the legs: τ = M qdd + C qd (+ g with gravity), as steps.
 
-    Spatial vectors in the base frame about its origin. Gravity enters as the base acceleration
-    (0, −g): a leg end then feels (m/3 + m/6) g = (m/2) g, the rod's weight split between its ends.
-    A leg of pair i couples its ends' accelerations: (m/6) a_b acts at a (body i−1) and (m/6) a_a at
-    b (body i); with a_p = c + L p for points of one body, the sums over the six legs need only
-    Σa, Σb and K = Σ a bᵀ.
+    Body i's velocity and acceleration are formed in B_i (where the joint adds S_i θ'_i,
+    S_i θ''_i, (V_{i−1} ×m S_i) θ'_i and d''_i θ'_i² e_z) and moved to Q_i; forces come back the
+    same way. The legs of pair i act in B_i: with point accelerations a_p = c + L p of a body
+    (c the acceleration of its point at the origin, L = [α]× + [ω]×²), the six legs' forces need
+    only Σa, Σb and K.
     """
     rec = _Recorder()
+    nm = Namer(rec, prefix)
     n = asm.n
-    name6 = lambda label, v: sp.Matrix([rec.name(f"{prefix}{label}_{k}", sp.expand(v[k])) for k in range(6)])
-    name3 = lambda label, v: sp.Matrix([rec.name(f"{prefix}{label}_{k}", sp.expand(v[k])) for k in range(3)])
-    V = [sp.zeros(6, 1)]
-    A = [sp.zeros(3, 1).col_join(-asm.g if gravity else sp.zeros(3, 1))]
-    for k, j in enumerate(asm.J, start=1):
-        S = asm._col(k)
-        V.append(name6(f"V{k}", V[-1] + S * qd[k - 1]))
-        Sdot = _cross_m(V[k - 1], S) + sp.zeros(3, 1).col_join(j["ddd"] * qd[k - 1] * asm.z[k - 1])
-        A.append(name6(f"A{k}", A[-1] + S * qdd[k - 1] + Sdot * qd[k - 1]))
-    # point accelerations of body j: a_p = c_j + L_j p
-    c = [name3(f"c{k}", A[k][3:, 0] + V[k][:3, 0].cross(V[k][3:, 0])) for k in range(n + 1)]
-    Lmat = [sp.zeros(3, 3)]
-    for k in range(1, n + 1):
-        w, al = V[k][:3, 0], A[k][:3, 0]
-        L = _skew(al) + _skew(w) * _skew(w)
-        Lmat.append(sp.Matrix(3, 3, [rec.name(f"{prefix}L{k}_{r}{q}", sp.expand(L[r, q])) for r in range(3) for q in range(3)]))
-    F = []
-    for k in range(1, n + 1):
-        Mk = asm._spatial(asm.bodies[k - 1])
-        F.append(Mk * A[k] + _cross_f(V[k], Mk * V[k]))
-    for i in range(1, n + 1):
-        Asum, Bsum, K, ml = asm.legsum[i]
-        # on body i (points b): (m/6) a_a, a_a = c_{i-1} + L_{i-1} a
-        f_b = ml / 6 * (6 * c[i - 1] + Lmat[i - 1] * Asum)
-        n_b = ml / 6 * (Bsum.cross(c[i - 1]) + _vee_antisym(K.T * Lmat[i - 1].T))
-        F[i - 1] += n_b.col_join(f_b)
-        if i >= 2:  # on body i-1 (points a): (m/6) a_b
-            f_a = ml / 6 * (6 * c[i] + Lmat[i] * Bsum)
-            n_a = ml / 6 * (Asum.cross(c[i]) + _vee_antisym(K * Lmat[i].T))
-            F[i - 2] += n_a.col_join(f_a)
+    add = lambda X, Y: (X[0] + Y[0], X[1] + Y[1])
+    V = (ZERO3, ZERO3)
+    A = (ZERO3, -asm.g if gravity else ZERO3)
+    forces, legs = [], []
+    for i, j in enumerate(asm.J, start=1):
+        if i > 1:
+            V = motion_to_child(asm.outer[i - 1], V, nm, "vb")
+            A = motion_to_child(asm.outer[i - 1], A, nm, "ab")
+        S = asm.S[i - 1]
+        VB = (nm.vec("Vw", V[0] + S[0] * qd[i - 1]), nm.vec("Vv", V[1] + S[1] * qd[i - 1]))
+        cm = cross_motion(V, S)
+        AB = (nm.vec("Aw", A[0] + S[0] * qdd[i - 1] + cm[0] * qd[i - 1]),
+              nm.vec("Av", A[1] + S[1] * qdd[i - 1] + cm[1] * qd[i - 1] + j["ddd"] * qd[i - 1] ** 2 * EZ))
+        # the legs of pair i, from the accelerations of their ends' bodies in B_i
+        ml, K = j["ml"], asm.K[i]
+        Sb = 6 * j["d"] * EZ
+        c_prev = nm.vec("lc", A[1] + V[0].cross(V[1]))
+        L_prev = nm.mat3("lL", skew(A[0]) + skew(V[0]) * skew(V[0]))
+        c_i = nm.vec("lc", AB[1] + VB[0].cross(VB[1]))
+        L_i = nm.mat3("lL", skew(AB[0]) + skew(VB[0]) * skew(VB[0]))
+        on_i = (nm.vec("lnb", ml / 6 * (Sb.cross(c_prev) + _vee_antisym(K.T * L_prev.T))), nm.vec("lfb", ml * c_prev))
+        on_prev = (nm.vec("lna", ml / 6 * _vee_antisym(K * L_i.T)), nm.vec("lfa", ml * (c_i + L_i * EZ * j["d"])))
+        legs.append((on_i, on_prev))
+        V = motion_to_child(asm.inner[i], VB, nm, "vq")
+        A = motion_to_child(asm.inner[i], AB, nm, "aq")
+        I = asm.bodies[i - 1]
+        mom = [nm.vec("hv", x) for x in apply_inertia(I, V)]
+        forces.append(add(apply_inertia(I, A), cross_force(V, mom)))
     tau = [None] * n
-    acc = None
-    for k in range(n, 0, -1):
-        acc = F[k - 1] if acc is None else F[k - 1] + acc
-        acc = name6(f"Fc{k}", acc)
-        tau[k - 1] = (asm._col(k).T * acc)[0]
+    carry = None
+    for i in range(n, 0, -1):
+        F = forces[i - 1] if carry is None else add(forces[i - 1], carry)
+        F = (nm.vec("Ftn", F[0]), nm.vec("Ftf", F[1]))
+        FB = force_to_parent(asm.inner[i], F, nm, "fb")
+        FB = add(FB, legs[i - 1][0])
+        FB = (nm.vec("FBn", FB[0]), nm.vec("FBf", FB[1]))
+        tau[i - 1] = asm._project(i, FB)
+        if i > 1:
+            carry = force_to_parent(asm.outer[i - 1], add(FB, legs[i - 1][1]), nm, "fo")
     return rec.steps, tau
+
+
+def kinetic_energy(asm: Assembly, prefix: str):
+    """T from the body velocities: ½ Σ V_iᵀ I_i V_i + Σ (m_i/6) V_{i−1}ᵀ X_i V_i (in B_i), as steps."""
+    rec = _Recorder()
+    nm = Namer(rec, prefix)
+    V, T = (ZERO3, ZERO3), sp.S(0)
+    for i, j in enumerate(asm.J, start=1):
+        if i > 1:
+            V = motion_to_child(asm.outer[i - 1], V, nm, "vb")
+        S = asm.S[i - 1]
+        VB = (nm.vec("Vw", V[0] + S[0] * j["qd"]), nm.vec("Vv", V[1] + S[1] * j["qd"]))
+        if i > 1:
+            K = asm.K[i]
+            top = (K.trace() * sp.eye(3) - K.T) * VB[0]
+            bottom = -6 * j["d"] * EZ.cross(VB[0]) + 6 * VB[1]
+            T += j["ml"] / 6 * ((V[0].T * top)[0] + (V[1].T * bottom)[0])
+        V = motion_to_child(asm.inner[i], VB, nm, "vq")
+        mom = apply_inertia(asm.bodies[i - 1], V)
+        T += ((V[0].T * mom[0])[0] + (V[1].T * mom[1])[0]) / 2
+        T = rec.name(f"{prefix}T{i}", sp.expand(T))
+    return rec.steps, T
 
 
 def lagrangian_bias(asm: Assembly):
@@ -296,7 +295,7 @@ def lagrangian_bias(asm: Assembly):
     qd = sp.Matrix([j["qd"] for j in asm.J])
     f_steps, Mdot = directional(asm.rec.steps, list(asm.M), asm.velocity_tangent(), "dMt_")
     L = (qd.T * asm.M * qd)[0] / 2 - asm.V
-    r_steps, grads = gradient(asm.rec.steps, L, "aL_")
+    r_steps, grads = gradient(asm.rec.steps + asm.vrec.steps, L, "aL_")
     bias = sp.Matrix(asm.n, asm.n, Mdot) * qd - sp.Matrix([_through_law(asm, grads, k) for k in range(1, asm.n + 1)])
     return f_steps + r_steps, list(bias)
 
@@ -305,12 +304,14 @@ def christoffel(asm: Assembly):
     """C = ½(Ṁ + W − Wᵀ), W_ij = ∂(M u)_i/∂θ_j at u = θ': exactly C_ij = Σ_k Γ_ijk θ'_k with the
     Christoffel symbols Γ_ijk = ½(∂_k M_ij + ∂_j M_ik − ∂_i M_jk). Ṁ is one directional derivative
     of M; M u comes from the recursion (no velocity, no gravity, acceleration u) and is differentiated
-    along each θ_j."""
+    along each θ_j (d'' never needs differentiating: it enters only with θ'²)."""
     n = asm.n
     qd = [j["qd"] for j in asm.J]
     steps, Mdot = directional(asm.rec.steps, list(asm.M), asm.velocity_tangent(), "dMt_")
     Mdot = sp.Matrix(n, n, Mdot)
     mu_steps, Mu = rnea(asm, [0] * n, qd, gravity=False, prefix="mu_")
+    third = {j["ddd"] for j in asm.J}
+    assert not any(e.free_symbols & third for _, e in asm.rec.steps + mu_steps)
     steps += mu_steps
     W = sp.zeros(n, n)
     for jx in range(1, n + 1):
@@ -322,26 +323,36 @@ def christoffel(asm: Assembly):
 
 
 def check_bias(n: int, samples: int = 2, digits: int = 30) -> float:
-    """Max |RNEA bias − Lagrangian bias| and |RNEA gravity − ∂V/∂θ| at random points."""
+    """Max over random points of |RNEA bias − Lagrangian bias|, |RNEA gravity − ∂V/∂θ| and
+    |RNEA(θ' = 0, no gravity) − M θ''| and |T from the velocities − ½ θ'ᵀMθ'|; the law's half
+    angles are those of a random θ."""
     import random
 
     import mpmath
 
     asm = Assembly(n)
     qd = [j["qd"] for j in asm.J]
+    qdd = [j["qdd"] for j in asm.J]
     r_steps, r_bias = rnea(asm, qd, [0] * n, gravity=True, prefix="r_")
     l_steps, l_bias = lagrangian_bias(asm)
     g_steps, r_g = rnea(asm, [0] * n, [0] * n, gravity=True, prefix="rg_")
-    v_steps, grads = gradient(asm.rec.steps, asm.V, "aV_")
+    v_steps, grads = gradient(asm.rec.steps + asm.vrec.steps, asm.V, "aV_")
     l_g = [_through_law(asm, grads, k) for k in range(1, n + 1)]
-    steps = asm.rec.steps + r_steps + l_steps + g_steps + v_steps
-    diffs = [a - b for a, b in zip(r_bias + r_g, l_bias + l_g)]
+    a_steps, r_Ma = rnea(asm, [0] * n, qdd, gravity=False, prefix="ra_")
+    Ma = list(asm.M * sp.Matrix(qdd))
+    t_steps, T = kinetic_energy(asm, "T_")
+    qdm = sp.Matrix(qd)
+    steps = asm.rec.steps + asm.vrec.steps + r_steps + l_steps + g_steps + v_steps + a_steps + t_steps
+    diffs = [a - b for a, b in zip(r_bias + r_g + r_Ma + [T], l_bias + l_g + Ma + [(qdm.T * asm.M * qdm)[0] / 2])]
     rng = random.Random(100 + n)
     worst = mpmath.mpf(0)
     inputs = [s for a in asm.args.values() for s in a.symbols]
     with mpmath.workdps(digits):
         for _ in range(samples):
             env = {s: mpmath.mpf(rng.uniform(-1, 1)) for s in inputs}
+            for j in asm.J:
+                th = mpmath.mpf(rng.uniform(-6, 6))
+                env[j["ch"]], env[j["sh"]] = mpmath.cos(th / 2), mpmath.sin(th / 2)
             for sym, e in steps:
                 env[sym] = sp.lambdify(sorted(e.free_symbols, key=str), e, "mpmath")(
                     *[env[v] for v in sorted(e.free_symbols, key=str)])
@@ -377,45 +388,57 @@ def cholesky_solve(M: sp.Matrix, rhs: list, prefix: str):
 
 
 def specs_for(n: int) -> list[KernelSpec]:
+    """The dynamics kernels of the n-joint chain. Forward dynamics, bias and energy call the mass
+    matrix and inverse dynamics kernels (`Call`) rather than repeat their code: the bias is the
+    inverse dynamics at θ'' = 0, forward dynamics solves M θ'' = τ − bias by Cholesky, and the
+    kinetic energy is ½ θ'ᵀMθ'."""
     asm = Assembly(n)
     base = list(asm.rec.steps)
     qd = [j["qd"] for j in asm.J]
     qdd = [j["qdd"] for j in asm.J]
     g_steps, g = rnea(asm, [0] * n, [0] * n, gravity=True, prefix="g_")
-    b_steps, bias = rnea(asm, qd, [0] * n, gravity=True, prefix="b_")
     i_steps, tau = rnea(asm, qd, qdd, gravity=True, prefix="id_")
     c_steps, C = christoffel(asm)
+    kin = ("law", "dh")
+    body = ("links", "legs")
+    mass = KernelSpec(f"mass_matrix{n}", f"Mass matrix M(theta) ({n} x {n}) of a {n}-joint chain, legs included.",
+                      SOURCE, asm.inputs(*kin, *body), [Arg("M", (n, n), "mass matrix, row-major", exprs=tuple(asm.M))],
+                      base)
+    inverse = KernelSpec(f"inverse_dynamics{n}", f"Joint torques tau = M theta'' + C theta' + g ({n}) of a {n}-joint chain.",
+                         SOURCE, asm.inputs("law", "qd", "qdd", "dh", *body, "gravity"),
+                         [Arg("tau", (n,), "joint torques [N m]", exprs=tuple(tau))], base + i_steps)
+    M_r = sp.Matrix(n, n, [sp.Symbol(f"rM{k}", real=True) for k in range(n * n)])
+    b_r = [sp.Symbol(f"rb{k}", real=True) for k in range(n)]
+    call_M = lambda *names: Call(mass, names, tuple(M_r))
+    call_bias = Call(inverse, ("law", "qd", None, "dh", "links", "legs", "gravity"), tuple(b_r))
     taus = [sp.Symbol(f"tau_{k}", real=True) for k in range(1, n + 1)]
-    f_steps, qdd_fd = cholesky_solve(asm.M, [t - b for t, b in zip(taus, bias)], "fd_")
+    f_steps, qdd_fd = cholesky_solve(M_r, [t - b for t, b in zip(taus, b_r)], "fd_")
     tau_arg = Arg("tau", (n,), "joint torques tau_i [N m]", tuple(taus))
     qdm = sp.Matrix(qd)
-    kin = ("theta", "dh", "law")
-    body = ("links", "legs")
-    T = (qdm.T * asm.M * qdm)[0] / 2
+    T = sp.expand((qdm.T * M_r * qdm)[0] / 2)
     return [
-        KernelSpec(f"mass_matrix{n}", f"Mass matrix M(theta) ({n} x {n}) of a {n}-joint chain, legs included.",
-                   SOURCE, asm.inputs(*kin, *body), [Arg("M", (n, n), "mass matrix, row-major", exprs=tuple(asm.M))], base),
+        mass,
         KernelSpec(f"gravity{n}", f"Gravity torques g(theta) = dV/dtheta ({n}) of a {n}-joint chain.",
                    SOURCE, asm.inputs(*kin, *body, "gravity"), [Arg("g", (n,), "gravity torques [N m]", exprs=tuple(g))],
                    base + g_steps),
         KernelSpec(f"coriolis{n}", f"Coriolis matrix C(theta, theta') ({n} x {n}, Christoffel form) of a {n}-joint chain.",
-                   SOURCE, asm.inputs("theta", "qd", "dh", "law", *body),
+                   SOURCE, asm.inputs("law", "qd", "dh", *body),
                    [Arg("C", (n, n), "C such that dM/dt - 2C is skew-symmetric, row-major", exprs=tuple(C))],
                    base + c_steps),
         KernelSpec(f"bias{n}", f"Bias C(theta, theta') theta' + g(theta) ({n}) of a {n}-joint chain.",
-                   SOURCE, asm.inputs("theta", "qd", "dh", "law", *body, "gravity"),
-                   [Arg("bias", (n,), "bias torques [N m]", exprs=tuple(bias))], base + b_steps),
-        KernelSpec(f"inverse_dynamics{n}", f"Joint torques tau = M theta'' + C theta' + g ({n}) of a {n}-joint chain.",
-                   SOURCE, asm.inputs("theta", "qd", "qdd", "dh", "law", *body, "gravity"),
-                   [Arg("tau", (n,), "joint torques [N m]", exprs=tuple(tau))], base + i_steps),
+                   SOURCE, asm.inputs("law", "qd", "dh", *body, "gravity"),
+                   [Arg("bias", (n,), "bias torques [N m]", exprs=tuple(b_r))],
+                   calls=[Call(inverse, ("law", "qd", None, "dh", "links", "legs", "gravity"), tuple(b_r))]),
+        inverse,
         KernelSpec(f"forward_dynamics{n}", f"Joint accelerations theta'' = M^-1 (tau - C theta' - g) ({n}) of a "
                    f"{n}-joint chain, by Cholesky (NaN where M is not positive definite).",
-                   SOURCE, asm.inputs("theta", "qd") + [tau_arg] + asm.inputs("dh", "law", *body, "gravity"),
-                   [Arg("qdd", (n,), "joint accelerations [rad/s^2]", exprs=tuple(qdd_fd))],
-                   base + b_steps + f_steps),
+                   SOURCE, asm.inputs("law", "qd") + [tau_arg] + asm.inputs("dh", *body, "gravity"),
+                   [Arg("qdd", (n,), "joint accelerations [rad/s^2]", exprs=tuple(qdd_fd))], f_steps,
+                   calls=[call_M("law", "dh", "links", "legs"), call_bias]),
         KernelSpec(f"energy{n}", f"Kinetic and potential energy (T, V) of a {n}-joint chain.",
-                   SOURCE, asm.inputs("theta", "qd", "dh", "law", *body, "gravity"),
-                   [Arg("energy", (2,), "(T, V) [J]", exprs=(T, asm.V))], base),
+                   SOURCE, asm.inputs("law", "qd", "dh", *body, "gravity"),
+                   [Arg("energy", (2,), "(T, V) [J]", exprs=(T, asm.V))], base + asm.vrec.steps,
+                   calls=[call_M("law", "dh", "links", "legs")]),
     ]
 
 

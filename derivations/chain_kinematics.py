@@ -1,13 +1,14 @@
 """Direct kinematics and geometric Jacobians of nA-chains, n = 1..6 (docs/conventions.md §3-§4).
 
 A_i(θ_i) = Rz(θ_i + φ_i) · Tz(c_i + d_i) · Tx(a_i) · Rx(α_i), each factor built from its elementary
-motion, both as a 4x4 matrix and as a Study point (dual-quaternion product). The joint law enters
-through the symbols d_i, d'_i, d''_i (the values of the pair's law at θ_i, computed by the law
-kernels), so one kernel serves R-pairs (d ≡ 0), sinusoidal and general A-pairs alike, and every
-design parameter is a kernel input.
+motion, both as a 4x4 matrix and as a Study point (dual-quaternion product). Each joint enters
+through its law values (cos(θ_i/2), sin(θ_i/2), d_i, d'_i, d''_i), computed by the pair's law kernel
+from one sincos of θ_i/2, so one chain kernel serves R-pairs (d ≡ 0), sinusoidal and general A-pairs
+alike without a trigonometric call of its own: cos θ, sin θ follow by the double-angle formulas
+and φ_i, α_i enter through their cos and sin, design constants that a batch computes once.
 
-The chain product is written as a recursion of named steps (frame i = frame i-1 · A_i), so the
-expanded expression is never formed. The Jacobian uses the screw form of docs/conventions.md §4 on those
+The chain product is written as a recursion of named steps (frame i = frame i-1 · A_i, with the
+rotation applied one elementary factor at a time), so the expanded expression is never formed. The Jacobian uses the screw form of docs/conventions.md §4 on those
 frames; `check_jacobian` proves it equal to the derivative of the forward kinematics
 (chain rule through d_i(θ_i)) at random points in 50-digit arithmetic.
 """
@@ -25,22 +26,43 @@ SOURCE = "derivations/chain_kinematics.py"
 MAX_N = 6
 
 
+LAW_FIELDS = ("ch", "sh", "d", "dd", "ddd")
+LAW_DOC = ("per joint (cos(theta_i/2), sin(theta_i/2), d_i [m], d'_i [m/rad], d''_i [m/rad^2]) from the "
+           "pair's law kernel")
+
+
 def joint_symbols(i: int) -> dict[str, sp.Symbol]:
-    """Symbols of joint i (1-based): angle, DH constants and the law values."""
-    names = ["theta", "a", "alpha", "c", "phi", "d", "dd", "ddd"]
+    """Symbols of joint i (1-based): the angle (for reference derivations), the law values
+    ch, sh = cos, sin(θ/2) and d, d', d'', and the DH constants."""
+    names = ("theta",) + LAW_FIELDS + ("a", "alpha", "c", "phi")
     return {k: sp.Symbol(f"{k}_{i}", real=True) for k in names}
 
 
-def chain_inputs(n: int, law_width: int = 3) -> tuple[list[Arg], list[dict]]:
-    """The three input arrays shared by every chain kernel: theta (n), dh (n, 4), law (n, 3)."""
+def chain_inputs(n: int) -> tuple[list[Arg], list[dict]]:
+    """The two input arrays shared by every chain kernel: law (n, 5) and dh (n, 4)."""
     J = [joint_symbols(i) for i in range(1, n + 1)]
     return [
-        Arg("theta", (n,), "joint angles theta_i [rad]", tuple(j["theta"] for j in J)),
+        Arg("law", (n, 5), LAW_DOC, tuple(j[k] for j in J for k in LAW_FIELDS)),
         Arg("dh", (n, 4), "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])",
             tuple(j[k] for j in J for k in ("a", "alpha", "c", "phi")), design=True),
-        Arg("law", (n, law_width), "per joint (d_i [m], d'_i [m/rad], d''_i [m/rad^2]) from a law kernel",
-            tuple(j[k] for j in J for k in ("d", "dd", "ddd")[:law_width])),
     ], J
+
+
+def at_angles(J: list[dict]) -> dict:
+    """The law's trigonometric inputs as functions of the angles, for reference derivations."""
+    out = {}
+    for j in J:
+        out[j["ch"]] = sp.cos(j["theta"] / 2)
+        out[j["sh"]] = sp.sin(j["theta"] / 2)
+    return out
+
+
+def joint_trig(j: dict, rec: "_Recorder", label: str) -> tuple[sp.Expr, sp.Expr, sp.Expr, sp.Expr]:
+    """(cos θ, sin θ, cos(θ + φ), sin(θ + φ)) of joint j as steps, from the half-angle law values."""
+    ct = rec.name(f"ct{label}", j["ch"] ** 2 - j["sh"] ** 2)
+    st = rec.name(f"st{label}", 2 * j["ch"] * j["sh"])
+    cp, sp_ = sp.cos(j["phi"]), sp.sin(j["phi"])
+    return ct, st, rec.name(f"cq{label}", ct * cp - st * sp_), rec.name(f"sq{label}", st * cp + ct * sp_)
 
 
 def _rot(axis: int, angle) -> sp.Matrix:
@@ -58,15 +80,23 @@ def _trans(axis: int, dist) -> sp.Matrix:
 
 
 def dh_matrix(j: dict) -> sp.Matrix:
-    """A_i as the product of its four elementary motions."""
+    """A_i as the product of its four elementary motions (in the angle θ_i)."""
     return _rot(2, j["theta"] + j["phi"]) * _trans(2, j["c"] + j["d"]) * _trans(0, j["a"]) * _rot(0, j["alpha"])
 
 
-def dh_study(j: dict):
-    """The Study point of A_i: the dual-quaternion product of the same four motions."""
-    half_t = (j["theta"] + j["phi"]) / 2
+def dh_study_half(j: dict) -> tuple[sp.Expr, sp.Expr]:
+    """cos and sin of (θ_i + φ_i)/2 from the law values and φ_i/2."""
+    cp, sp_ = sp.cos(j["phi"] / 2), sp.sin(j["phi"] / 2)
+    return j["ch"] * cp - j["sh"] * sp_, j["sh"] * cp + j["ch"] * sp_
+
+
+def dh_study(j: dict, half=None):
+    """The Study point of A_i: the dual-quaternion product of the same four motions. `half`:
+    (cos, sin) of (θ_i + φ_i)/2, by default from the law values (ch, sh) and φ_i/2."""
+    if half is None:
+        half = dh_study_half(j)
     half_a = j["alpha"] / 2
-    return (rotation((0, 0, 1), sp.cos(half_t), sp.sin(half_t)) * translation((0, 0, j["c"] + j["d"]))
+    return (rotation((0, 0, 1), *half) * translation((0, 0, j["c"] + j["d"]))
             * translation((j["a"], 0, 0)) * rotation((1, 0, 0), sp.cos(half_a), sp.sin(half_a)))
 
 
@@ -86,18 +116,24 @@ class _Recorder:
 
 
 def frames(n: int, J: list[dict], rec: _Recorder) -> list[sp.Matrix]:
-    """Frames 0..n as 4x4 matrices whose entries are step symbols (frame 0 = identity)."""
+    """Frames 0..n as 4x4 matrices whose entries are step symbols (frame 0 = identity).
+
+    R_i = R_{i-1} Rz(θ_i + φ_i) Rx(α_i) one factor at a time (U = R_{i-1} Rz first), and
+    o_i = o_{i-1} + (c_i + d_i) z_{i-1} + a_i U e_x: 24 multiplications per joint."""
     out = [sp.eye(4)]
     for i, j in enumerate(J, start=1):
-        A = dh_matrix(j)
-        if i == 1:
-            T = A
-        else:
-            T = out[-1] * A
+        _, _, cq, sq = joint_trig(j, rec, f"{i}")
+        T = out[-1]
+        R = [T[:3, k] for k in range(3)]
+        U0 = [rec.name(f"U{i}_{r}0", sp.expand(R[0][r] * cq + R[1][r] * sq)) for r in range(3)]
+        U1 = [rec.name(f"U{i}_{r}1", sp.expand(R[1][r] * cq - R[0][r] * sq)) for r in range(3)]
+        ca, sa = sp.cos(j["alpha"]), sp.sin(j["alpha"])
         named = sp.eye(4)
         for r in range(3):
-            for c in range(4):
-                named[r, c] = rec.name(f"T{i}_{r}{c}", sp.expand(T[r, c]) if i > 1 else T[r, c])
+            named[r, 0] = U0[r]
+            named[r, 1] = rec.name(f"T{i}_{r}1", sp.expand(U1[r] * ca + R[2][r] * sa))
+            named[r, 2] = rec.name(f"T{i}_{r}2", sp.expand(R[2][r] * ca - U1[r] * sa))
+            named[r, 3] = rec.name(f"T{i}_{r}3", sp.expand(T[r, 3] + (j["c"] + j["d"]) * R[2][r] + j["a"] * U0[r]))
         out.append(named)
     return out
 
@@ -117,11 +153,15 @@ def fk_spec(n: int) -> KernelSpec:
 def fk_study_spec(n: int) -> KernelSpec:
     inputs, J = chain_inputs(n)
     rec = _Recorder()
-    comps = [sp.expand(c) for c in dh_study(J[0]).as_list()]
+    def joint(i, j):
+        half = [rec.name(f"H{i}_{k}", e) for k, e in enumerate(dh_study_half(j))]
+        return [rec.name(f"Q{i}_{k}", sp.expand(c)) for k, c in enumerate(dh_study(j, half).as_list())]
+
+    comps = joint(1, J[0])
     for i, j in enumerate(J[1:], start=2):
         prev = [rec.name(f"S{i - 1}_{k}", c) for k, c in enumerate(comps)]
-        joint = [rec.name(f"Q{i}_{k}", sp.expand(c)) for k, c in enumerate(dh_study(j).as_list())]
-        P = StudyPoint(Quaternion(*prev[:4]), Quaternion(*prev[4:])) * StudyPoint(Quaternion(*joint[:4]), Quaternion(*joint[4:]))
+        joint_i = joint(i, j)
+        P = StudyPoint(Quaternion(*prev[:4]), Quaternion(*prev[4:])) * StudyPoint(Quaternion(*joint_i[:4]), Quaternion(*joint_i[4:]))
         comps = [sp.expand(c) for c in P.as_list()]
     return KernelSpec(
         name=f"fk_study{n}",
@@ -162,8 +202,9 @@ def jacobian_spec(n: int) -> KernelSpec:
 def check_jacobian(n: int, samples: int = 3, digits: int = 50) -> float:
     """Max |screw Jacobian − derivative of FK| over random points, in `digits`-digit arithmetic.
 
-    The derivative is taken on the fully expanded FK, with d/dθ_i = ∂/∂θ_i + d'_i ∂/∂d_i, and the
-    angular part from the skew matrix (∂R/∂θ_i) Rᵀ: an independent route to the same columns.
+    The derivative is taken on the fully expanded FK in the angles θ_i, with
+    d/dθ_i = ∂/∂θ_i + d'_i ∂/∂d_i, and the angular part from the skew matrix (∂R/∂θ_i) Rᵀ: an
+    independent route to the same columns (which come from the half-angle law values).
     """
     _, J = chain_inputs(n)
     T = sp.eye(4)
@@ -181,7 +222,7 @@ def check_jacobian(n: int, samples: int = 3, digits: int = 50) -> float:
     env = {}
     for s, e in rec.steps:
         env[s] = e.xreplace(env)
-    J_screw = screw_jacobian(F, J).xreplace(env)
+    J_screw = screw_jacobian(F, J).xreplace(env).xreplace(at_angles(J))
     syms = sorted(J_diff.free_symbols | J_screw.free_symbols, key=str)
     f = sp.lambdify(syms, J_diff - J_screw, modules="mpmath")
     rng = random.Random(n)
@@ -198,7 +239,8 @@ def joint_polynomials() -> PolynomialSet:
     """The single DH joint, as a matrix and as a Study point, for reading."""
     j = joint_symbols(1)
     A = dh_matrix(j)
-    P = dh_study(j)
+    half_t = (j["theta"] + j["phi"]) / 2
+    P = dh_study(j, (sp.cos(half_t), sp.sin(half_t)))
     comps = [sp.factor(sp.expand(c)) for c in P.as_list()]
     names = ["x0", "x1", "x2", "x3", "y0", "y1", "y2", "y3"]
     return PolynomialSet(
@@ -226,7 +268,7 @@ def chain_study_polynomials(n: int = 2) -> PolynomialSet:
         gens += [C, S, K, L, j["a"], D]
         half_t, half_a = (j["theta"] + j["phi"]) / 2, j["alpha"] / 2
         subs.update({sp.cos(half_t): C, sp.sin(half_t): S, sp.cos(half_a): K, sp.sin(half_a): L})
-        Q = dh_study(j)
+        Q = dh_study(j, (sp.cos(half_t), sp.sin(half_t)))
         Q = StudyPoint(Quaternion(*[sp.expand(c).xreplace(subs).subs(j["c"] + j["d"], D) for c in Q.x.as_list()]),
                        Quaternion(*[sp.expand(sp.expand(c).xreplace(subs).subs(j["c"], D - j["d"])) for c in Q.y.as_list()]))
         P = Q if P is None else P * Q

@@ -34,9 +34,22 @@ class Arg:
         return n
 
 
+@dataclass(frozen=True)
+class Call:
+    """Another kernel evaluated inside this one, so that its code exists once: `kernel` is the
+    callee's spec (one output), `args` names, for each of its inputs, the caller's input passed
+    (same shape) or None for zeros, and `results` are the caller's symbols for the callee's
+    output, row-major."""
+
+    kernel: "KernelSpec"
+    args: tuple[str | None, ...]
+    results: tuple[sp.Symbol, ...]
+
+
 @dataclass
 class KernelSpec:
-    """One generated function: inputs (symbol arrays) -> outputs (expression arrays)."""
+    """One generated function: inputs (symbol arrays) -> outputs (expression arrays). `calls`
+    are kernels it evaluates first; their results are symbols the steps and outputs may use."""
 
     name: str
     doc: str
@@ -44,6 +57,7 @@ class KernelSpec:
     inputs: list[Arg]
     outputs: list[Arg]
     steps: list[tuple[sp.Symbol, sp.Expr]] = field(default_factory=list)
+    calls: list[Call] = field(default_factory=list)
 
     def __post_init__(self):
         for a in self.inputs:
@@ -53,6 +67,18 @@ class KernelSpec:
             if len(a.exprs) != a.size:
                 raise ValueError(f"{self.name}: output {a.name} has {len(a.exprs)} exprs for shape {a.shape}")
         known = {s for a in self.inputs for s in a.symbols}
+        mine = {a.name: a for a in self.inputs}
+        for c in self.calls:
+            callee = c.kernel
+            if len(callee.outputs) != 1 or len(c.results) != callee.outputs[0].size or c.kernel.calls:
+                raise ValueError(f"{self.name}: a call of {callee.name} needs one result symbol per output entry "
+                                 "of a callee with one output and no calls of its own")
+            if len(c.args) != len(callee.inputs):
+                raise ValueError(f"{self.name}: {callee.name} takes {len(callee.inputs)} inputs")
+            for name, a in zip(c.args, callee.inputs):
+                if name is not None and (name not in mine or tuple(mine[name].shape) != tuple(a.shape)):
+                    raise ValueError(f"{self.name}: {callee.name}'s input {a.name} {a.shape} cannot be {name}")
+            known |= set(c.results)
         for sym, expr in self.steps:
             if sym in known:
                 raise ValueError(f"{self.name}: step {sym} is defined twice (or shadows an input)")
@@ -66,8 +92,29 @@ class KernelSpec:
                 if missing:
                     raise ValueError(f"{self.name}: output {a.name} uses undefined {sorted(map(str, missing))}")
 
+    def flattened(self) -> "KernelSpec":
+        """The same function without calls: each callee's steps inlined (renamed), its inputs
+        replaced by the caller's symbols (or zeros) and its outputs bound to the result symbols."""
+        if not self.calls:
+            return self
+        mine = {a.name: a for a in self.inputs}
+        steps = []
+        for k, c in enumerate(self.calls):
+            sub = {}
+            for name, a in zip(c.args, c.kernel.inputs):
+                for s, t in zip(a.symbols, mine[name].symbols if name is not None else [0] * a.size):
+                    sub[s] = sp.S(t)
+            for sym, e in c.kernel.steps:
+                new = sp.Symbol(f"c{k}_{sym.name}", real=True)
+                steps.append((new, e.xreplace(sub)))
+                sub[sym] = new
+            steps += [(r, sp.S(e).xreplace(sub)) for r, e in zip(c.results, c.kernel.outputs[0].exprs)]
+        return KernelSpec(self.name, self.doc, self.source, self.inputs, self.outputs, steps + list(self.steps))
+
     def expanded_outputs(self) -> list[sp.Expr]:
         """All output expressions with the steps substituted (a DAG: shared subtrees stay shared)."""
+        if self.calls:
+            return self.flattened().expanded_outputs()
         env: dict = {}
         for sym, expr in self.steps:
             env[sym] = expr.xreplace(env)
@@ -77,6 +124,8 @@ class KernelSpec:
         """Content hash of the spec: names, shapes, symbols and expressions (srepr is canonical)."""
         h = hashlib.sha256()
         h.update(self.name.encode())
+        for c in self.calls:
+            h.update(f"call {c.kernel.fingerprint()} {c.args} {[str(r) for r in c.results]}".encode())
         for a in self.inputs:
             h.update(f"in {a.name} {a.shape} {[str(s) for s in a.symbols]}{' design' if a.design else ''}".encode())
         for sym, expr in self.steps:

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 9531a14ec32d3534
+Content hash: ad35696682d1dab4
 """

@@ -310,12 +310,8 @@ def test_no_allocation_io_or_mutable_state_in_the_library():
 
 def test_a_program_links_only_the_kernels_it_calls(tmp_path):
     """One source per kernel: a firmware build that calls inverse_dynamics4 from the static library
-    takes that kernel's object alone (not the 1.6 MB of every chain's dynamics)."""
-    program = tmp_path / "id4.c"
-    program.write_text(
-        '#include "apair.h"\nint main(void)\n{\n    double q[4] = {0}, qd[4] = {0}, qdd[4] = {0}, dh[16] = {0}, '
-        "law[12] = {0}, links[40] = {0}, legs[12] = {0}, g[3] = {0, 0, -9.81}, tau[4];\n"
-        "    apair_inverse_dynamics4(q, qd, qdd, dh, law, links, legs, g, tau);\n    return tau[0] != tau[0];\n}\n")
+    takes that kernel's object alone (not the whole library), and one that calls forward_dynamics4
+    takes it with the two kernels it calls (mass matrix and inverse dynamics), nothing else."""
     objects = tmp_path / "obj"
     objects.mkdir()
     with ThreadPoolExecutor(max_workers=2) as pool:
@@ -323,10 +319,27 @@ def test_a_program_links_only_the_kernels_it_calls(tmp_path):
                                      str(objects / (Path(s).stem + ".o"))]), SOURCES))
     archive = tmp_path / "libapair.a"
     run(["ar", "rcs", str(archive), *sorted(str(p) for p in objects.glob("*.o"))])
-    exe = tmp_path / "id4"
-    run(["gcc", "-std=c99", f"-I{CDIR}", str(program), str(archive), "-lm", "-o", str(exe)])
-    assert subprocess.run([str(exe)]).returncode == 0
-    symbols = run(["nm", str(exe)]).stdout
-    defined = sorted(line.split()[-1] for line in symbols.splitlines() if " T apair_" in line)
-    assert defined == ["apair_inverse_dynamics4", "apair_inverse_dynamics4_batch"]
-    assert exe.stat().st_size < 200_000
+    internal = lambda k: [f"apair_internal_{k}_core", f"apair_internal_{k}_invariants"]
+    cases = {
+        "apair_inverse_dynamics4(law, qd, qdd, dh, links, legs, g, out);":
+            ["apair_inverse_dynamics4", "apair_inverse_dynamics4_batch"] + internal("inverse_dynamics4"),
+        "apair_forward_dynamics4(law, qd, qdd, dh, links, legs, g, out);":
+            ["apair_forward_dynamics4", "apair_forward_dynamics4_batch"] + internal("inverse_dynamics4")
+            + internal("mass_matrix4") + ["apair_inverse_dynamics4", "apair_inverse_dynamics4_batch",
+                                          "apair_mass_matrix4", "apair_mass_matrix4_batch"],
+    }
+    for call, expected in cases.items():
+        program = tmp_path / "prog.c"
+        program.write_text(
+            '#include "apair.h"\nint main(void)\n{\n    double law[20] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, '
+            "1, 0, 0, 0, 0}, qd[4] = {0}, qdd[4] = {0}, dh[16] = {0}, links[40] = {0}, legs[12] = {0}, "
+            "g[3] = {0, 0, -9.81}, out[4];\n    int i;\n    for (i = 0; i < 4; ++i) {\n"
+            "        links[10 * i] = links[10 * i + 4] = links[10 * i + 5] = links[10 * i + 6] = 1.0;\n    }\n"
+            f"    {call}\n    return out[0] != out[0];\n}}\n")
+        exe = tmp_path / "prog"
+        run(["gcc", "-std=c99", f"-I{CDIR}", str(program), str(archive), "-lm", "-o", str(exe)])
+        assert subprocess.run([str(exe)]).returncode == 0
+        symbols = run(["nm", str(exe)]).stdout
+        defined = sorted(line.split()[-1] for line in symbols.splitlines() if " T apair_" in line)
+        assert defined == sorted(expected)
+        assert exe.stat().st_size < 200_000

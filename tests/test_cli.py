@@ -75,7 +75,7 @@ def test_kernels(capsys):
     rows = {line.split()[0]: line for line in out.splitlines()}
     for n in range(1, 7):
         assert {f"fk{n}", f"fk_study{n}", f"jacobian{n}"} <= rows.keys()
-    assert "law_sinusoidal" in rows and "-> law(3,)" in rows["law_sinusoidal"]
+    assert "law_sinusoidal" in rows and "-> law(5,)" in rows["law_sinusoidal"]
     assert re.search(r"fk2\s+\d+ ops", rows["fk2"])
 
 

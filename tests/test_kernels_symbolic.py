@@ -22,6 +22,12 @@ def random_inputs(spec, rng: np.random.Generator, count: int) -> list[np.ndarray
         else:
             x = rng.uniform(-3.0, 3.0, shape)
         out.append(x)
+    names = [a.name for a in spec.inputs]
+    if "law" in names and spec.inputs[names.index("law")].shape[-1] == 5:
+        # chain kernels: the law's half angles are those of an angle (the rotations are rotations)
+        law = out[names.index("law")]
+        half = rng.uniform(-np.pi, np.pi, law.shape[:-1])
+        law[..., 0], law[..., 1] = np.cos(half), np.sin(half)
     if spec.name.startswith("forward_dynamics"):  # physical links: M is positive definite
         links = out[[a.name for a in spec.inputs].index("links")]
         links[..., 0] = rng.uniform(0.5, 3.0, links.shape[:-1])
@@ -78,25 +84,32 @@ def test_kernel_matches_symbolic(name, derived, backend):
 def test_batched_broadcasts_shared_inputs(backend):
     """A design shared by the whole batch (stride 0) gives the same as repeating it."""
     rng = np.random.default_rng(7)
-    theta = rng.uniform(-3, 3, (11, 3))
     dh = rng.uniform(-1, 1, (3, 4))
-    law = rng.uniform(-1, 1, (11, 3, 3))
-    shared = call("fk3", theta, dh, law)[0]
-    repeated = call("fk3", theta, np.broadcast_to(dh, (11, 3, 4)).copy(), law)[0]
+    law = rng.uniform(-1, 1, (11, 3, 5))
+    shared = call("fk3", law, dh)[0]
+    repeated = call("fk3", law, np.broadcast_to(dh, (11, 3, 4)).copy())[0]
     np.testing.assert_array_equal(shared, repeated)
-    grid = call("fk3", theta.reshape(11, 1, 3), dh, law.reshape(11, 1, 3, 3))[0]
+    grid = call("fk3", law.reshape(11, 1, 3, 5), dh)[0]
     assert grid.shape == (11, 1, 4, 4)
     np.testing.assert_array_equal(grid[:, 0], shared)
+    # a composite kernel (forward dynamics calls the mass matrix and inverse dynamics kernels)
+    chain_args = [rng.uniform(-1, 1, (11, 3)), rng.uniform(-1, 1, (11, 3))]
+    links = np.tile([1.0, 0.1, 0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0], (3, 1))
+    legs, g = np.zeros((3, 3)), np.array([0.0, 0.0, -9.81])
+    law[..., :2] = np.stack([np.cos(law[..., 0]), np.sin(law[..., 0])], axis=-1)
+    shared = call("forward_dynamics3", law, *chain_args, dh, links, legs, g)[0]
+    repeated = call("forward_dynamics3", law, *chain_args, *(np.broadcast_to(x, (11,) + x.shape).copy()
+                                                            for x in (dh, links, legs, g)))[0]
+    np.testing.assert_array_equal(shared, repeated)
 
 
 def test_non_contiguous_inputs(backend):
     """Strided views and Fortran-ordered arrays give the same results as contiguous copies."""
     rng = np.random.default_rng(11)
-    big = rng.uniform(-3, 3, (20, 6))
-    theta = big[:, ::2]  # a strided view, (20, 3)
+    big = rng.uniform(-3, 3, (20, 3, 10))
+    law = big[:, :, ::2]  # a strided view, (20, 3, 5)
     dh = np.asfortranarray(rng.uniform(-1, 1, (3, 4)))
-    law = np.asfortranarray(rng.uniform(-1, 1, (20, 3, 3)))
-    got = call("jacobian3", theta, dh, law)[0]
-    want = call("jacobian3", np.ascontiguousarray(theta), np.ascontiguousarray(dh), np.ascontiguousarray(law))[0]
+    got = call("jacobian3", law, dh)[0]
+    want = call("jacobian3", np.ascontiguousarray(law), np.ascontiguousarray(dh))[0]
     np.testing.assert_array_equal(got, want)
     assert got.shape == (20, 6, 3)

@@ -43,7 +43,7 @@ static void print(const char *name, const double *x, int size)
 int main(int argc, char **argv)
 {
     double q[N] = {0}, qd[N] = {0}, qdd[N] = {0};
-    double law[N][3], legs[N][3];
+    double law[N][5], legs[N][3];
     double T[16], J[6 * N], tau[N];
     int i;
 
@@ -55,7 +55,8 @@ int main(int argc, char **argv)
         double *x = i <= N ? q : i <= 2 * N ? qd : qdd;
         x[(i - 1) % N] = strtod(argv[i], NULL);
     }
-    /* each sinusoidal pair: its amplitude h from the radii, then (d, d', d'') at its angle */
+    /* each sinusoidal pair: its amplitude h from the radii, then its law values at its angle,
+     * (cos(q/2), sin(q/2), d, d', d''): one sincos per joint, the chain kernels need no other */
     for (i = 0; i < N; ++i) {
         double design[5];
         apair_design_sinusoidal(radii[i], design); /* (L1, L2, a, b, h) */
@@ -64,9 +65,9 @@ int main(int argc, char **argv)
         legs[i][1] = radii[i][0];
         legs[i][2] = radii[i][1];
     }
-    apair_fk4(q, &dh[0][0], &law[0][0], T);
-    apair_jacobian4(q, &dh[0][0], &law[0][0], J);
-    apair_inverse_dynamics4(q, qd, qdd, &dh[0][0], &law[0][0], &links[0][0], &legs[0][0], gravity, tau);
+    apair_fk4(&law[0][0], &dh[0][0], T);
+    apair_jacobian4(&law[0][0], &dh[0][0], J);
+    apair_inverse_dynamics4(&law[0][0], qd, qdd, &dh[0][0], &links[0][0], &legs[0][0], gravity, tau);
     printf("apair %s (%s)\n", APAIR_VERSION, APAIR_CONTENT_HASH);
     print("T", T, 16);
     print("J", J, 6 * N);

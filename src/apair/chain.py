@@ -1,8 +1,9 @@
 """`AChain`: a serial chain of R- and A-pairs in the DH convention of docs/conventions.md §3.
 
 Joint i: A_i(θ_i) = Rz(θ_i + φ_i) · Tz(c_i + d_i(θ_i)) · Tx(a_i) · Rx(α_i). Each method computes
-the joints' law values with their pairs' kernels and hands everything to one generated chain
-kernel for n joints (derivations/chain_kinematics.py); batches stay in the kernel.
+the joints' law values (cos(θ/2), sin(θ/2), d, d', d'') with their pairs' kernels and hands them
+to one generated chain kernel for n joints (derivations/chain_kinematics.py, chain_dynamics.py);
+batches stay in the kernels.
 """
 from __future__ import annotations
 
@@ -121,8 +122,7 @@ class AChain:
         """One call per law kernel (APair.law_kernel): (kernel, joint indices, parameters (k, 1))."""
         by_kernel: dict[str, list[int]] = {}
         for i, p in enumerate(self.pairs):
-            if p.law_kernel is not None:
-                by_kernel.setdefault(p.law_kernel[0], []).append(i)
+            by_kernel.setdefault(p.law_kernel[0], []).append(i)
         groups = []
         for kernel, idx in sorted(by_kernel.items()):
             values = np.array([self.pairs[i].law_kernel[1] for i in idx])
@@ -132,20 +132,24 @@ class AChain:
 
     def law(self, q) -> np.ndarray:
         """(..., n, 3): each joint's (d, d', d'') at q."""
-        return self._law(self._q(q))
+        return self._law(self._q(q))[..., 2:]
 
     def _law(self, q: np.ndarray) -> np.ndarray:
-        """law() of a validated q; each pair with a restricted range checks its angles."""
-        for i in self._ranged:
-            self.pairs[i]._theta(q[..., i], name=f"q[..., {i}]")
-        out = np.zeros(q.shape + (3,))
+        """(..., n, 5): the chain kernels' law input (cos(θ/2), sin(θ/2), d, d', d'') of a
+        validated q; each pair with a restricted range checks its angles."""
+        for i in self._ranged:  # angles past the range end by rounding are put on it
+            snapped = self.pairs[i]._theta(q[..., i], name=f"q[..., {i}]")
+            if not np.array_equal(snapped, q[..., i]):
+                q = q.copy()
+                q[..., i] = snapped
+        out = np.empty(q.shape + (5,))
         for kernel, idx, params in self._law_groups:
             out[..., idx, :] = call(kernel, q[..., idx, None], *params)[0]
         return out
 
     def _kernel(self, stem: str, q):
         q = self._q(q)
-        return call(f"{stem}{self.n}", q, self._dh, self._law(q))[0]
+        return call(f"{stem}{self.n}", self._law(q), self._dh)[0]
 
     def fk(self, q) -> np.ndarray:
         """(..., 4, 4): the pose of frame n in the base frame; q is (n,) or (..., n)."""
@@ -157,8 +161,8 @@ class AChain:
 
     def jacobian(self, q) -> np.ndarray:
         """(..., 6, n): geometric Jacobian, base frame, rows [v; ω] (v of the origin of frame n)."""
-        (q,), law = self._state(q)
-        return call(f"jacobian{self.n}", q, self._dh, law)[0]
+        _, law = self._state(q)
+        return call(f"jacobian{self.n}", law, self._dh)[0]
 
     # ----------------------------------------------------------------------------- dynamics
     def _state(self, q, **named):
@@ -173,40 +177,42 @@ class AChain:
             raise ValueError(f"{first}: batch shape does not match q: {[x.shape for x in arrays]}") from None
         arrays = [x if x.shape == shape else np.broadcast_to(x, shape) for x in arrays]
         law = self._law(arrays[0])
-        if self._ranged and not np.isfinite(law).all():
-            raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
+        for i in self._ranged:  # at the range end (up to rounding) d' is unbounded
+            t = arrays[0][..., i]
+            t = np.abs(t - 2 * np.pi * np.round(t / (2 * np.pi)))
+            if np.any(t >= self.pairs[i].theta_limit) or not np.isfinite(law[..., i, :]).all():
+                raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
         return arrays, law
 
     def mass_matrix(self, q) -> np.ndarray:
         """(..., n, n): M(θ), legs included."""
-        (q,), law = self._state(q)
-        return call(f"mass_matrix{self.n}", q, self._dh, law, self._links, self._legs)[0]
+        _, law = self._state(q)
+        return call(f"mass_matrix{self.n}", law, self._dh, self._links, self._legs)[0]
 
     def coriolis_matrix(self, q, qd) -> np.ndarray:
         """(..., n, n): C(θ, θ') in Christoffel form (Ṁ − 2C is skew-symmetric)."""
-        (q, qd), law = self._state(q, qd=qd)
-        return call(f"coriolis{self.n}", q, qd, self._dh, law, self._links, self._legs)[0]
+        (_, qd), law = self._state(q, qd=qd)
+        return call(f"coriolis{self.n}", law, qd, self._dh, self._links, self._legs)[0]
 
     def gravity_torques(self, q) -> np.ndarray:
         """(..., n): g(θ) = ∂V/∂θ."""
-        (q,), law = self._state(q)
-        return call(f"gravity{self.n}", q, self._dh, law, self._links, self._legs, self.gravity)[0]
+        _, law = self._state(q)
+        return call(f"gravity{self.n}", law, self._dh, self._links, self._legs, self.gravity)[0]
 
     def bias(self, q, qd) -> np.ndarray:
         """(..., n): C(θ, θ')θ' + g(θ)."""
-        (q, qd), law = self._state(q, qd=qd)
-        return call(f"bias{self.n}", q, qd, self._dh, law, self._links, self._legs, self.gravity)[0]
+        (_, qd), law = self._state(q, qd=qd)
+        return call(f"bias{self.n}", law, qd, self._dh, self._links, self._legs, self.gravity)[0]
 
     def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
         """(..., n): τ = M(θ)θ'' + C(θ, θ')θ' + g(θ), torques about the pair axes."""
-        (q, qd, qdd), law = self._state(q, qd=qd, qdd=qdd)
-        return call(f"inverse_dynamics{self.n}", q, qd, qdd, self._dh, law, self._links, self._legs,
-                    self.gravity)[0]
+        (_, qd, qdd), law = self._state(q, qd=qd, qdd=qdd)
+        return call(f"inverse_dynamics{self.n}", law, qd, qdd, self._dh, self._links, self._legs, self.gravity)[0]
 
     def forward_dynamics(self, q, qd, tau) -> np.ndarray:
         """(..., n): θ'' = M⁻¹(τ − C θ' − g), by a Cholesky factorisation of M inside one kernel."""
-        (q, qd, tau), law = self._state(q, qd=qd, tau=tau)
-        qdd = call(f"forward_dynamics{self.n}", q, qd, tau, self._dh, law, self._links, self._legs, self.gravity)[0]
+        (_, qd, tau), law = self._state(q, qd=qd, tau=tau)
+        qdd = call(f"forward_dynamics{self.n}", law, qd, tau, self._dh, self._links, self._legs, self.gravity)[0]
         if not np.isfinite(qdd).all():
             raise ValueError("links: the mass matrix is not positive definite at this q "
                              "(give every moving body mass and inertia)")
@@ -214,8 +220,8 @@ class AChain:
 
     def energy(self, q, qd) -> np.ndarray:
         """(..., 2): kinetic and potential energy (T, V) [J], legs included."""
-        (q, qd), law = self._state(q, qd=qd)
-        return call(f"energy{self.n}", q, qd, self._dh, law, self._links, self._legs, self.gravity)[0]
+        (_, qd), law = self._state(q, qd=qd)
+        return call(f"energy{self.n}", law, qd, self._dh, self._links, self._legs, self.gravity)[0]
 
     def simulate(self, q0, qd0, t, tau=None, rtol=1e-10, atol=1e-12, method="DOP853", limits="stop"):
         """Integrate the equations of motion from (q0, qd0) and report the state at times `t`.

@@ -457,6 +457,7 @@ class _Elimination:
             if not count_complex:
                 u3s = u3s[np.abs(u3s.imag) <= CAND_TOL * (1 + np.abs(u3s))].real
             rights, images = self._right_pairs(u3s, C, real=not count_complex)
+            rights, images = _with_cluster_means(rights, images, C)
         out = []
         for right, W in zip(rights, images):
             out += [np.concatenate([left, right]) for left in self._solve_left(W, 2)]
@@ -464,6 +465,25 @@ class _Elimination:
 
 
 # ----------------------------------------------------------------------------- helpers
+def _with_cluster_means(pairs: np.ndarray, images: np.ndarray, C: np.ndarray):
+    """The pairs (u_3, u_4) and their images, plus the mean of every two pairs that agree to
+    CAND_TOL: a double root (special poses square the resultant) comes out as two simple roots
+    about √ε apart, too inaccurate for the left half, while their mean is accurate to about ε.
+    Candidates are kept as they are, so two close genuine solutions are not merged (verification
+    and deduplication decide)."""
+    if len(pairs) < 2:
+        return pairs, images
+    diff = np.abs(pairs[:, None, :] - pairs[None, :, :])
+    close = np.all(diff <= CAND_TOL * (1 + np.abs(pairs[:, None, :])), axis=-1)
+    i, j = np.nonzero(np.triu(close, 1))
+    if len(i) == 0:
+        return pairs, images
+    means = (pairs[i] + pairs[j]) / 2
+    Cu = np.einsum("ri,ija->rja", means[:, 0:1] ** np.arange(C.shape[0]), C)
+    extra = np.einsum("rj,rja->ra", means[:, 1:2] ** np.arange(C.shape[1]), Cu)
+    return np.concatenate([pairs, means]), np.concatenate([images, extra])
+
+
 def _left(p: np.ndarray) -> np.ndarray:
     """The 8×8 matrix of v ↦ p·v (Study product)."""
     return multiply(p, np.eye(8)).T

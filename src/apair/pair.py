@@ -103,14 +103,21 @@ class APair:
     @property
     def theta_limit(self) -> float | None:
         """|θ| ≤ arccos(−a/b) for a general pair with a < b (the largest double at which
-        a + b cos θ ≥ 0 still holds in floating point, so d(theta_limit) = 0 is defined); None
-        where θ is unbounded."""
+        a + b cos θ ≥ 0 still holds in floating point as the law kernel forms it, so
+        d(theta_limit) ≈ 0 is defined, within √(b ε) of zero); None where θ is unbounded."""
         if self.kind == "general" and self.a < self.b:
             lim = math.acos(-self.a / self.b)
-            while self.a + self.b * math.cos(lim) < 0:
+            while self._gap(lim) < 0:
                 lim = math.nextafter(lim, 0.0)
+            while self._gap(math.nextafter(lim, math.pi)) >= 0 and lim < math.pi:
+                lim = math.nextafter(lim, math.pi)
             return lim
         return None
+
+    def _gap(self, theta: float) -> float:
+        """a + b cos θ as the law kernel forms it, from cos and sin of θ/2."""
+        c, s = math.cos(theta / 2), math.sin(theta / 2)
+        return self.a + self.b * (c * c - s * s)
 
     def collision_limits(self):
         """(theta_min, theta_max, what touches first): the collision-free range of θ around 0, where
@@ -136,7 +143,8 @@ class APair:
         rounding (a + b cos θ ≥ −4ε(|a| + b)) are put on it, anything further is refused."""
         th = V.real_array(name, theta)
         if self.kind == "general" and self.a < self.b:
-            gap = self.a + self.b * np.cos(th)
+            c, s = np.cos(th / 2), np.sin(th / 2)
+            gap = self.a + self.b * (c * c - s * s)  # as the law kernel forms it
             bad = gap < 0
             if np.any(bad):
                 far = gap < -4 * np.finfo(float).eps * (abs(self.a) + self.b)
@@ -150,21 +158,20 @@ class APair:
 
     def law(self, theta, name="theta") -> np.ndarray:
         """(..., 3): d(θ), d'(θ), d''(θ); broadcasts over θ."""
-        return self._law(self._theta(theta, name))
+        return self._law(self._theta(theta, name))[..., 2:]
 
     @property
-    def law_kernel(self) -> tuple[str, tuple[float, ...]] | None:
-        """The generated kernel of this pair's law and its parameters after θ; None for an
-        R-pair (d = 0)."""
+    def law_kernel(self) -> tuple[str, tuple[float, ...]]:
+        """The generated kernel of this pair's law values (cos(θ/2), sin(θ/2), d, d', d'') and
+        its parameters after θ."""
         if self.kind == "revolute":
-            return None
+            return "law_revolute", ()
         if self.kind == "sinusoidal":
             return "law_sinusoidal", (self._h,)
         return "law_general", (self.a, self.b)
 
     def _law(self, th: np.ndarray) -> np.ndarray:
-        if self.law_kernel is None:
-            return np.zeros(th.shape + (3,))
+        """(..., 5): the law values of validated angles."""
         kernel, params = self.law_kernel
         return call(kernel, th[..., None], *([x] for x in params))[0]
 
@@ -192,7 +199,7 @@ class APair:
         except ValueError:
             raise ValueError(f"qd: shapes {th.shape}, {qd.shape}, {qdd.shape} of theta, qd, qdd do not broadcast") from None
         th, qd, qdd = (np.broadcast_to(x, shape) for x in (th, qd, qdd))
-        law = self._law(th)
+        law = self._law(th)[..., 2:]
         if np.any(~np.isfinite(law)):
             raise ValueError("theta: at the pair's limit, where d'(theta) is unbounded")
         row = platform.as_row()
@@ -205,5 +212,5 @@ class APair:
         th = self._theta(theta)
         if self.kind == "revolute":
             return np.zeros(th.shape + (0, 2, 3))
-        d = self._law(th)[..., 0]
+        d = self._law(th)[..., 2]
         return call("pair_legs", th[..., None], d[..., None], [self.base_radius, self.platform_radius])[0]
