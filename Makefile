@@ -43,7 +43,7 @@ lib:
 	$(MAKE) --no-print-directory -j$(NPROC) build/libapair.so
 build/libapair.so: $(C_OBJECTS)
 	gcc -shared $^ -o $@ -lm
-build/obj/%.o: generated/c/%.c generated/c/apair.h
+build/obj/%.o: generated/c/%.c generated/c/apair.h generated/c/apair_internal.h
 	@mkdir -p build/obj
 	gcc $(CFLAGS_STRICT) -fPIC -c $< -o $@
 
@@ -61,8 +61,15 @@ check: install
 test: install lib check
 	$(PY) -m pytest -q
 
-# Timings (never asserted by tests): results in bench/results.json.
-bench: install
+# Timings (never asserted by tests): results in bench/results.json. The peers (the bench extra of
+# pyproject.toml) are installed here only; builds of the C/C++ peers are kept in build/bench.
+BENCH_STAMP := $(VENV)/.bench-stamp
+$(BENCH_STAMP): pyproject.toml | $(DEPS_STAMP)
+	$(PY) -m pip install --quiet $$($(PY) -c "import tomllib; print(' '.join(\
+	  tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['bench']))")
+	touch $@
+
+bench: install $(BENCH_STAMP)
 	PYTHONPATH=. $(PY) bench/run.py $(BENCH_ARGS)
 
 clean:

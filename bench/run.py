@@ -1,5 +1,14 @@
 """`make bench`: the generated kernels against the tools users would pick instead, in one run.
 
+First the compiled comparison (bench/native.py), what a C user would pick instead: for a 6-joint
+chain with random DH constants and links (R-pairs, so every tool models the same chain) and 10 000
+random states, apair's generated C (each joint's law kernel, then the chain kernel's batch) against
+Pinocchio's C++ compiled from its headers and CasADi's C code generated from Pinocchio's
+algorithms on casadi::SX (design baked in, and design as inputs), same gcc flags (-std=c99 or
+c++17, -O2 and -O3, -DNDEBUG, no fast-math, no -march), one pinned core, agreement checked first,
+minimum over round-robin rounds; then the A-chain case (sinusoidal pairs with leg mass), where
+no peer can follow. Then, from Python:
+
 For chains of n = 2, 4, 6 joints (random DH constants and links; R-pairs, i.e. A-pairs with h = 0,
 so that Pinocchio models exactly the same chain) it times forward kinematics, the Jacobian, the
 mass matrix, inverse and forward dynamics with
@@ -118,7 +127,7 @@ def specs(n: int) -> dict:
     from derivations import chain_dynamics, chain_kinematics
 
     out = {f"fk{n}": chain_kinematics.fk_spec(n), f"jacobian{n}": chain_kinematics.jacobian_spec(n)}
-    out.update({s.name: s for s in chain_dynamics.specs_for(n)})
+    out.update({s.name: s.flattened() for s in chain_dynamics.specs_for(n)})
     return out
 
 
@@ -170,9 +179,8 @@ def bench_chain(n: int, rng, batch: int, single: int, slow: int, repeats: int, p
     qd = rng.normal(size=(batch, n))
     qdd = rng.normal(size=(batch, n))
     tau = rng.normal(size=(batch, n))
-    law = np.zeros((n, 3))
-    design = {"dh": chain._dh, "law": law, "links": chain._links, "legs": chain._legs, "gravity": chain.gravity}
-    per_pose = {"theta": q, "qd": qd, "qdd": qdd, "tau": tau}
+    design = {"dh": chain._dh, "links": chain._links, "legs": chain._legs, "gravity": chain.gravity}
+    per_pose = {"law": chain._law(q), "qd": qd, "qdd": qdd, "tau": tau}
     pin_f, pin_check = pin_functions(chain) if pin_ok else ({}, {})
     out = {}
     for op in OPS:
@@ -237,7 +245,7 @@ def batch_scaling(n: int, rng, repeats: int) -> dict:
         rows = {}
         for size in (1, 10, 100, 1000, 10_000, 100_000):
             q = rng.uniform(-np.pi, np.pi, (size, n))
-            args = {"theta": q, "qd": q, "qdd": q, "dh": chain._dh, "law": np.zeros((n, 3)), "links": chain._links,
+            args = {"law": chain._law(q), "qd": q, "qdd": q, "dh": chain._dh, "links": chain._links,
                     "legs": chain._legs, "gravity": chain.gravity}
             inputs = [args[a["name"]] for a in kernels.manifest()["kernels"][name]["inputs"]]
             calls = max(1, 20_000 // size)
@@ -253,6 +261,90 @@ def time_generate() -> float:
         subprocess.run([sys.executable, "-m", "codegen", "--out", tmp], cwd=ROOT, check=True,
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         return time.perf_counter() - t0
+
+
+def random_achain(n: int, rng) -> apair.AChain:
+    """random_chain's kind of design with sinusoidal A-pairs whose legs have mass."""
+    r = random_chain(n, rng)
+    pairs = [apair.APair(*rng.uniform(0.03, 0.08, 2), leg_mass=rng.uniform(0.02, 0.1)) for _ in range(n)]
+    return apair.AChain(pairs, r.a, r.alpha, r.offset, r.theta_offset, links=r.links, gravity=r.gravity)
+
+
+def native_section(rng, quick: bool) -> dict:
+    """The compiled comparison (bench/native.py) for n = 6: the R-chain with every peer, and an
+    A-chain with apair alone."""
+    from bench import native
+
+    count, rounds = (2000, 3) if quick else (10_000, 7)
+    work = ROOT / "build" / "bench"
+    out = {}
+    for label, chain in (("R-chain", random_chain(6, rng)), ("A-chain", random_achain(6, rng))):
+        lim = np.array([min(p.theta_limit or np.pi, np.pi) * 0.95 for p in chain.pairs])
+        states = native.States(rng.uniform(-lim, lim, (count, 6)), rng.normal(size=(count, 6)),
+                               rng.normal(size=(count, 6)), rng.normal(size=(count, 6)))
+        print(f"compiled comparison, {label} (n = 6, {count} states):", file=sys.stderr, flush=True)
+        out[label] = native.compare(chain, states, work / label, rounds=rounds, peers=label == "R-chain",
+                                    log=lambda m: print(m, file=sys.stderr, flush=True))
+    manifest = kernels.manifest()["kernels"]
+    out["apair_ops_per_item"] = {op: manifest[f"{op}6"]["ops_per_item"] for op in native.OPERATIONS}
+    return out
+
+
+def native_targets(native_res: dict) -> list[dict]:
+    """Issue 15's targets: per opt level, M, ID, FD <= 0.7 x Pinocchio C++ and <= 1.0 x CasADi with
+    the design as inputs; fk and Jacobian <= 0.8 x Pinocchio and <= 1.3 x their trigonometric calls."""
+    tools = native_res["R-chain"]["tools"]
+    out = []
+    for opt in ("-O2", "-O3"):
+        me = tools.get(f"apair {opt}")
+        if me is None:
+            continue
+        floor = me["ns"]["trig_floor"]
+        for op in ("mass_matrix", "inverse_dynamics", "forward_dynamics", "fk", "jacobian"):
+            limits = [("pinocchio", 0.7 if op not in ("fk", "jacobian") else 0.8)]
+            if op not in ("fk", "jacobian"):
+                limits.append(("casadi_design", 1.0))
+            for peer, bound in limits:
+                other = tools.get(f"{peer} {opt}")
+                if other is None:
+                    continue
+                r = me["ns"][op] / other["ns"][op]
+                out.append({"target": f"{op} {opt}: apair <= {bound} x {peer}", "measured": r, "met": r <= bound})
+            if op in ("fk", "jacobian"):
+                r = me["ns"][op] / floor
+                out.append({"target": f"{op} {opt}: apair <= 1.3 x its sincos calls alone", "measured": r,
+                            "met": r <= 1.3})
+    return out
+
+
+def print_native(native_res: dict) -> None:
+    r = native_res["R-chain"]
+    names = list(r["tools"])
+    print("\ncompiled, n = 6 R-chain, ns per evaluation (min over rounds); ratio = apair / peer at the same -O:")
+    print(f"{'':18s}" + "".join(f"{n:>17s}" for n in names))
+    for op in ("fk", "jacobian", "mass_matrix", "inverse_dynamics", "forward_dynamics"):
+        cells = []
+        for name in names:
+            t = r["tools"][name]["ns"][op]
+            opt = name.split()[-1]
+            mine = r["tools"][f"apair {opt}"]["ns"][op]
+            cells.append(f"{t:8.0f}" + (f" ({mine / t:.2f})" if not name.startswith("apair") else "       "))
+        print(f"{op:18s}" + "".join(f"{c:>17s}" for c in cells))
+    for opt in ("-O2", "-O3"):
+        me = r["tools"].get(f"apair {opt}")
+        if me:
+            print(f"apair {opt}: sincos of the 6 half angles alone {me['ns']['trig_floor']:.0f} ns, "
+                  f"the 6 law kernels {me['ns']['law_kernels']:.0f} ns")
+    worst = max(v for t in r["tools"].values() for v in t["difference"].values())
+    print(f"largest difference from apair (relative to the largest value): {worst:.1e}")
+    print("operations per evaluation: apair " + ", ".join(f"{k} {v}" for k, v in native_res["apair_ops_per_item"].items()))
+    if "casadi_ops" in r:
+        print("CasADi SX operations: " + ", ".join(f"{k} {v}" for k, v in r["casadi_ops"].items()))
+    for tool, why in r["skipped"].items():
+        print(f"skipped {tool}: {why}")
+    a = native_res["A-chain"]
+    print("A-chain (sinusoidal pairs with leg mass, n = 6), apair only: " + "; ".join(
+        f"{name}: " + ", ".join(f"{op} {t:.0f}" for op, t in a['tools'][name]['ns'].items()) for name in a["tools"]))
 
 
 def random_4a(rng) -> apair.AChain:
@@ -312,6 +404,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="bench/run.py", description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="small batches and few repeats (a smoke run)")
     ap.add_argument("--no-generate", action="store_true", help="skip timing make generate")
+    ap.add_argument("--native-only", action="store_true", help="only the compiled comparison with the C/C++ peers")
     ap.add_argument("--out", type=Path, default=ROOT / "bench" / "results.json")
     args = ap.parse_args(argv)
     try:
@@ -333,6 +426,16 @@ def main(argv=None) -> int:
                "kernels": {}}
     if not (pin_ok and se_ok):
         print("note: install the bench extra (pip install .[bench]) for Pinocchio and symengine", file=sys.stderr)
+    results["native"] = native_section(rng, args.quick)
+    results["native_targets"] = native_targets(results["native"])
+    print_native(results["native"])
+    print("\ntargets (compiled):")
+    for t in results["native_targets"]:
+        print(f"  [{'met' if t['met'] else 'MISSED'}] {t['target']}: {t['measured']:.3g}")
+    if args.native_only:
+        args.out.write_text(json.dumps(results, indent=1) + "\n")
+        print(f"written to {args.out}")
+        return 0
     for n in (2, 4, 6):
         print(f"n = {n}: deriving the expressions for lambdify/symengine and timing ...", file=sys.stderr, flush=True)
         results["kernels"][str(n)] = bench_chain(n, rng, batch, single, slow, repeats, pin_ok, se_ok)

@@ -84,7 +84,7 @@ class Lowered:
     ops: int
     fingerprint: str
     hoisted: Hoisted | None  # None: nothing depends on design inputs alone
-    calls: list[LoweredCall]  # kernels evaluated first (their own hoisting applies); then no `hoisted`
+    calls: list[LoweredCall]  # kernels evaluated first (their own hoisting applies)
 
     @property
     def name(self) -> str:
@@ -209,7 +209,7 @@ def lower(spec: KernelSpec) -> Lowered:
         for name, a in call.args:
             if a.design and name is None:
                 raise ValueError(f"{spec.name}: {c.kernel.name}'s design input {a.name} cannot be zeros")
-    hoisted = None if calls else _hoist(spec, local, assignments, reduced, printed["c"])
+    hoisted = _hoist(spec, local, assignments, reduced, printed["c"])
     return Lowered(signature, inputs, code["c"], code["py"], ops, spec.fingerprint(), hoisted, calls)
 
 
@@ -314,6 +314,8 @@ class Emitter:
                     "inputs": [{"name": a.name, "shape": list(a.shape), "doc": a.doc} for a in k.spec.inputs],
                     "outputs": [{"name": a.name, "shape": list(a.shape), "doc": a.doc} for a in k.spec.outputs],
                     "ops": k.ops,
+                    # per item of a batch that shares its design (callees counted in)
+                    "ops_per_item": _ops_per_item(k, by_name),
                     "fingerprint": fingerprints[k.name][:16],
                 }
         files["numpy/__init__.py"] = self.env.get_template("numpy_init.py.j2").render(
@@ -324,6 +326,11 @@ class Emitter:
         manifest["files"] = sorted(set(files) | {"manifest.json"})  # what a later run may replace or remove
         files["manifest.json"] = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
         return files
+
+
+def _ops_per_item(k: Lowered, by_name: dict) -> int:
+    own = k.hoisted.core_ops if k.hoisted else k.ops
+    return own + sum(_ops_per_item(by_name[c.kernel], by_name) for c in k.calls)
 
 
 def render_polynomials(poly_sets: list[PolynomialSet]) -> dict[str, str]:

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: ad35696682d1dab4
+Content hash: 8807fcd79a4d6cd6
 """

@@ -1,0 +1,434 @@
+"""Compiled programs that time apair's generated C and its C/C++ peers on the same chain and states.
+
+Each tool gets a small program, compiled with the same flags, that reads the same binary input
+file (the states of `count` poses and the chain's design), evaluates every operation over all poses
+in round-robin rounds, and prints the minimum ns per evaluation of each operation over the rounds
+as JSON; it also writes its results for the first poses so that agreement is checked before any
+timing is reported (each program first runs one untimed warm-up round). apair's path is the one a C user takes: each joint's law kernel (one sincos
+per joint), then the chain kernel's batch function with the design shared by the batch.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+CHECKED = 16  # poses whose results each program writes for the agreement check
+
+# the chain kernel, its per-pose inputs (after law) and its output size, per operation
+OPERATIONS = {
+    "fk": ("fk", (), lambda n: 16),
+    "jacobian": ("jacobian", (), lambda n: 6 * n),
+    "mass_matrix": ("mass_matrix", (), lambda n: n * n),
+    "inverse_dynamics": ("inverse_dynamics", ("qd", "qdd"), lambda n: n),
+    "forward_dynamics": ("forward_dynamics", ("qd", "tau"), lambda n: n),
+}
+
+
+@dataclass
+class States:
+    """The poses every tool evaluates: q, qd, qdd, tau (count, n)."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    tau: np.ndarray
+
+    @property
+    def count(self) -> int:
+        return self.q.shape[0]
+
+    @property
+    def n(self) -> int:
+        return self.q.shape[1]
+
+
+def write_inputs(path: Path, chain, states: States) -> None:
+    """count, n, then q, qd, qdd, tau, dh, links, legs, gravity, law parameters (n) as doubles."""
+    law_param = np.array([p.law_kernel[1][0] if p.law_kernel[1] else 0.0 for p in chain.pairs])
+    head = np.array([states.count, states.n], dtype=np.float64)
+    parts = [head, states.q, states.qd, states.qdd, states.tau, chain._dh, chain._links, chain._legs, chain.gravity,
+             law_param]
+    np.concatenate([np.ascontiguousarray(p, dtype=np.float64).ravel() for p in parts]).tofile(path)
+
+
+READER = r"""
+static double *Q, *QD, *QDD, *TAU, DH[24], LINKS[60], LEGS[18], GRAV[3], LAWP[6];
+static long COUNT;
+static int N;
+
+static int read_inputs(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    double head[2];
+    long k;
+    if (!f || fread(head, sizeof(double), 2, f) != 2) return 1;
+    COUNT = (long)head[0];
+    N = (int)head[1];
+    Q = (double *)malloc(sizeof(double) * COUNT * N);
+    QD = (double *)malloc(sizeof(double) * COUNT * N);
+    QDD = (double *)malloc(sizeof(double) * COUNT * N);
+    TAU = (double *)malloc(sizeof(double) * COUNT * N);
+    k = COUNT * N;
+    if (fread(Q, sizeof(double), k, f) != (size_t)k || fread(QD, sizeof(double), k, f) != (size_t)k
+        || fread(QDD, sizeof(double), k, f) != (size_t)k || fread(TAU, sizeof(double), k, f) != (size_t)k
+        || fread(DH, sizeof(double), 4 * N, f) != (size_t)(4 * N) || fread(LINKS, sizeof(double), 10 * N, f) != (size_t)(10 * N)
+        || fread(LEGS, sizeof(double), 3 * N, f) != (size_t)(3 * N) || fread(GRAV, sizeof(double), 3, f) != 3
+        || fread(LAWP, sizeof(double), N, f) != (size_t)N) return 1;
+    fclose(f);
+    return 0;
+}
+
+static double now_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec * 1e9 + t.tv_nsec;
+}
+"""
+
+
+def apair_program(chain) -> str:
+    """C source timing the generated kernels for `chain` (its pairs' law kernels are fixed here,
+    the design is read at run time)."""
+    n = chain.n
+    law_calls = []
+    for i, p in enumerate(chain.pairs):
+        kernel, params = p.law_kernel
+        extra = "".join(f", &LAWP[{i}]" for _ in params)
+        law_calls.append(f"apair_{kernel}(&q[{i}]{extra}, &law[{5 * i}]);")
+    laws = "\n            ".join(law_calls)
+    half = "\n            ".join(f"acc += cos(0.5 * q[{i}]) + sin(0.5 * q[{i}]);" for i in range(n))
+    ops_code = []
+    for op, (stem, extra, size) in OPERATIONS.items():
+        args = ["LAW", "0" if False else f"{5 * n}"]
+        call_inputs = [f"LAW, {5 * n}"]
+        for name in extra:
+            call_inputs.append(f"{name.upper()}, {n}")
+        design = {"fk": ["DH, 0"], "jacobian": ["DH, 0"], "mass_matrix": ["DH, 0", "LINKS, 0", "LEGS, 0"]}.get(
+            op, ["DH, 0", "LINKS, 0", "LEGS, 0", "GRAV, 0"])
+        del args
+        ops_code.append((op, f"apair_{stem}{n}_batch((size_t)COUNT, {', '.join(call_inputs + design)}, OUT_{op});",
+                         size(n)))
+    body = []
+    for op, call, size in ops_code:
+        body.append(f"""
+        t0 = now_ns();
+        laws_all();
+        {call}
+        t = (now_ns() - t0) / COUNT;
+        if (round > 0 && t < best[{len(body)}]) best[{len(body)}] = t;""")
+    names = [op for op, _, _ in ops_code]
+    outs = "\n".join(f"static double *OUT_{op};" for op in names)
+    allocs = "\n    ".join(f"OUT_{op} = (double *)malloc(sizeof(double) * COUNT * {size});" for op, _, size in ops_code)
+    dumps = "\n    ".join(f"fwrite(OUT_{op}, sizeof(double), {CHECKED} * {size}, f);" for op, _, size in ops_code)
+    prints = " ".join(f'printf("%s\\"{op}\\": %.3f", "{"{" if k == 0 else ", "}", best[{k}]);'
+                      for k, op in enumerate(names))
+    return f"""#define _POSIX_C_SOURCE 199309L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "apair.h"
+{READER}
+static double *LAW;
+{outs}
+
+static void laws_all(void)
+{{
+    long k;
+    for (k = 0; k < COUNT; ++k) {{
+        const double *q = Q + k * {n};
+        double *law = LAW + k * {5 * n};
+        {laws}
+    }}
+}}
+
+static double trig_only(void)
+{{
+    double acc = 0;
+    long k;
+    for (k = 0; k < COUNT; ++k) {{
+        const double *q = Q + k * {n};
+        {half}
+    }}
+    return acc;
+}}
+
+int main(int argc, char **argv)
+{{
+    double best[{len(names) + 2}], t0, t, sink = 0;
+    int round, k;
+    FILE *f;
+    if (argc < 4 || read_inputs(argv[1])) return 2;
+    LAW = (double *)malloc(sizeof(double) * COUNT * {5 * n});
+    {allocs}
+    for (k = 0; k < {len(names) + 2}; ++k) best[k] = 1e300;
+    for (round = 0; round <= atoi(argv[3]); ++round) {{{''.join(body)}
+        t0 = now_ns();
+        sink += trig_only();
+        t = (now_ns() - t0) / COUNT;
+        if (round > 0 && t < best[{len(names)}]) best[{len(names)}] = t;
+        t0 = now_ns();
+        laws_all();
+        t = (now_ns() - t0) / COUNT;
+        if (round > 0 && t < best[{len(names) + 1}]) best[{len(names) + 1}] = t;
+    }}
+    f = fopen(argv[2], "wb");
+    {dumps}
+    fclose(f);
+    {prints}
+    printf(", \\"trig_floor\\": %.3f, \\"law_kernels\\": %.3f, \\"sink\\": %.3g}}\\n", best[{len(names)}], best[{len(names) + 1}], sink);
+    return 0;
+}}
+"""
+
+
+def pinned(cmd: list[str]) -> list[str]:
+    """cmd run on one core (the last one) where taskset exists."""
+    taskset = shutil.which("taskset")
+    if taskset:
+        return [taskset, "-c", str(max(os.cpu_count() or 1, 1) - 1)] + cmd
+    return cmd
+
+
+def compile_c(source: str, out: Path, flags: list[str], extra: list[str]) -> None:
+    """gcc -std=c99 FLAGS -DNDEBUG: the flags of the comparison (no fast-math, no -march)."""
+    src = out.with_suffix(".c")
+    src.write_text(source)
+    subprocess.run(["gcc", "-std=c99", *flags, "-DNDEBUG", str(src), *extra, "-o", str(out)], check=True)
+
+
+def cached(exe: Path, key: list[str], build) -> Path:
+    """exe, rebuilt by build() only when `key` (sources and flags) changed since the last build."""
+    import hashlib
+
+    digest = hashlib.sha256("\0".join(key).encode()).hexdigest()
+    stamp = exe.with_name(exe.name + ".key")
+    if exe.exists() and stamp.exists() and stamp.read_text() == digest:
+        return exe
+    build()
+    stamp.write_text(digest)
+    return exe
+
+
+def run_program(exe: Path, inputs: Path, outputs: Path, rounds: int) -> dict:
+    res = subprocess.run(pinned([str(exe), str(inputs), str(outputs), str(rounds)]), check=True, capture_output=True,
+                         text=True)
+    return json.loads(res.stdout)
+
+
+def apair_build(chain, workdir: Path, opt: str) -> Path:
+    """The apair timing program for `chain`, linked with the generated sources it calls."""
+    c_dir = ROOT / "generated" / "c"
+    n = chain.n
+    kernels = [f"{stem}{n}" for stem, _, _ in OPERATIONS.values()]
+    kernels += sorted({p.law_kernel[0] for p in chain.pairs})
+    exe = workdir / f"apair{n}_{'_'.join(sorted({p.law_kernel[0][4:] for p in chain.pairs}))}{opt}"
+    compile_c(apair_program(chain), exe, [opt, f"-I{c_dir}"], [str(c_dir / f"{k}.c") for k in kernels] + ["-lm"])
+    return exe
+
+
+def read_outputs(path: Path, n: int) -> dict:
+    data = np.fromfile(path, dtype=np.float64)
+    out, pos = {}, 0
+    for op, (_, _, size) in OPERATIONS.items():
+        k = CHECKED * size(n)
+        out[op] = data[pos:pos + k].reshape(CHECKED, -1)
+        pos += k
+    return out
+
+
+def cmeel_prefix() -> Path | None:
+    """The prefix holding the C++ headers and libraries of the pin/libpinocchio and cmeel wheels."""
+    import site
+    import sysconfig
+
+    for base in [sysconfig.get_paths()["purelib"], *site.getsitepackages()]:
+        p = Path(base) / "cmeel.prefix"
+        if (p / "include" / "pinocchio").is_dir():
+            return p
+    return None
+
+
+BOOST_DEFINES = ["-DBOOST_MPL_LIMIT_LIST_SIZE=30", "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
+                 "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS", "-DBOOST_FUSION_INVOKE_MAX_ARITY=12"]
+
+
+def pinocchio_build(workdir: Path, opt: str) -> Path:
+    """Pinocchio's C++ timing program (bench/peers/pinocchio_timing.cpp) at optimisation `opt`."""
+    prefix = cmeel_prefix()
+    if prefix is None or not (prefix / "include" / "eigen3").is_dir():
+        raise RuntimeError("Pinocchio's C++ headers or Eigen are missing: pip install '.[bench]'")
+    exe = workdir / f"pinocchio{opt}"
+    source = ROOT / "bench" / "peers" / "pinocchio_timing.cpp"
+    # Pinocchio's own compile definitions for Boost (its CMake config), but not its
+    # PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION: the algorithms are compiled here, with these flags
+    cmd = ["g++", "-std=c++17", opt, "-DNDEBUG", *BOOST_DEFINES, f"-I{prefix / 'include'}",
+           f"-I{prefix / 'include' / 'eigen3'}", str(source), "-o", str(exe)]
+    return cached(exe, cmd + [source.read_text(), str(prefix)], lambda: subprocess.run(cmd, check=True))
+
+
+def casadi_dirs() -> tuple[Path, Path] | None:
+    """(include dir, library dir) of the casadi wheel, or None."""
+    try:
+        import casadi
+    except ImportError:
+        return None
+    base = Path(casadi.__file__).parent
+    if not (base / "include" / "casadi" / "casadi.hpp").is_file():
+        return None
+    return base / "include", base
+
+
+def casadi_generate(workdir: Path, inputs: Path) -> Path:
+    """CasADi C code of Pinocchio's algorithms for the chain in `inputs` (pin_baked.c, pin_design.c),
+    from bench/peers/casadi_codegen.cpp; returns the folder holding them."""
+    prefix, dirs = cmeel_prefix(), casadi_dirs()
+    if prefix is None or dirs is None:
+        raise RuntimeError("Pinocchio's headers or the casadi wheel are missing: pip install '.[bench]'")
+    include, lib = dirs
+    exe = workdir / "casadi_codegen"
+    source = ROOT / "bench" / "peers" / "casadi_codegen.cpp"
+    cmd = ["g++", "-std=c++17", "-O1", *BOOST_DEFINES, f"-I{prefix / 'include'}", f"-I{prefix / 'include' / 'eigen3'}",
+           f"-I{include}", str(source), f"-L{lib}", "-lcasadi", f"-Wl,-rpath,{lib}", "-o", str(exe)]
+    cached(exe, cmd + [source.read_text()], lambda: subprocess.run(cmd, check=True))
+    out = workdir / f"casadi_c_{inputs.stem}"
+    out.mkdir(exist_ok=True)
+    res = subprocess.run([str(exe), str(inputs.resolve()), str(out)], check=True, cwd=out, capture_output=True, text=True)
+    (out / "ops.json").write_text(res.stdout)
+    return out
+
+
+def casadi_program(n: int, prefix: str) -> str:
+    """C source timing CasADi's generated functions `{prefix}<op>` over the poses, one call per pose."""
+    design = prefix == "pind_"
+    specs = {"fk": ("Q", [], ["DH"]), "jacobian": ("Q", [], ["DH"]), "mass_matrix": ("Q", [], ["DH", "LINKS"]),
+             "inverse_dynamics": ("Q", ["QD", "QDD"], ["DH", "LINKS", "GRAV"]),
+             "forward_dynamics": ("Q", ["QD", "TAU"], ["DH", "LINKS", "GRAV"])}
+    blocks, outs, allocs, dumps = [], [], [], []
+    for k, (op, (q, state, des)) in enumerate(specs.items()):
+        size = OPERATIONS[op][2](n)
+        fn = f"{prefix}{op}"
+        args = [f"{q} + i * {n}"] + [f"{s} + i * {n}" for s in state] + (des if design else [])
+        outs.append(f"static double *OUT_{op};")
+        allocs.append(f"OUT_{op} = (double *)malloc(sizeof(double) * COUNT * {size});")
+        dumps.append(f"fwrite(OUT_{op}, sizeof(double), {CHECKED} * {size}, f);")
+        sets = "\n                ".join(f"arg[{j}] = {a};" for j, a in enumerate(args))
+        blocks.append(f"""
+        {{
+            casadi_int sz_arg, sz_res, sz_iw, sz_w;
+            const casadi_real *arg[16];
+            casadi_real *res[4];
+            static casadi_int iw[4096];
+            static casadi_real w[65536];
+            long i;
+            {fn}_work(&sz_arg, &sz_res, &sz_iw, &sz_w);
+            if (sz_iw > 4096 || sz_w > 65536) return 3;
+            t0 = now_ns();
+            for (i = 0; i < COUNT; ++i) {{
+                {sets}
+                res[0] = OUT_{op} + i * {size};
+                {fn}(arg, res, iw, w, 0);
+            }}
+            t = (now_ns() - t0) / COUNT;
+            if (round > 0 && t < best[{k}]) best[{k}] = t;
+        }}""")
+    prints = " ".join(f'printf("%s\\"{op}\\": %.3f", "{"{" if k == 0 else ", "}", best[{k}]);' for k, op in enumerate(specs))
+    return f"""#define _POSIX_C_SOURCE 199309L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "{'pin_design.h' if design else 'pin_baked.h'}"
+{READER}
+{chr(10).join(outs)}
+
+int main(int argc, char **argv)
+{{
+    double best[5] = {{1e300, 1e300, 1e300, 1e300, 1e300}}, t0, t;
+    int round;
+    FILE *f;
+    if (argc < 4 || read_inputs(argv[1])) return 2;
+    {chr(10).join("    " + a for a in allocs).strip()}
+    for (round = 0; round <= atoi(argv[3]); ++round) {{{''.join(blocks)}
+    }}
+    f = fopen(argv[2], "wb");
+    {chr(10).join("    " + d for d in dumps).strip()}
+    fclose(f);
+    {prints}
+    printf("}}\\n");
+    return 0;
+}}
+"""
+
+
+def casadi_build(workdir: Path, c_dir: Path, n: int, design: bool, opt: str) -> Path:
+    prefix = "pind_" if design else "pin_"
+    exe = workdir / f"casadi_{'design' if design else 'baked'}{n}{opt}"
+    source = c_dir / f"pin_{'design' if design else 'baked'}.c"
+    compile_c(casadi_program(n, prefix), exe, [opt, f"-I{c_dir}"], [str(source), "-lm"])
+    return exe
+
+
+# ------------------------------------------------------------------------------------ the comparison
+AGREE = 5e-12  # largest relative difference (to the largest |value|) accepted before timing
+
+
+def _agreement(ref: dict, got: dict) -> dict:
+    return {op: float(np.max(np.abs(got[op] - ref[op])) / max(np.max(np.abs(ref[op])), 1.0)) for op in ref}
+
+
+def compare(chain, states: States, workdir: Path, opts=("-O2", "-O3"), rounds: int = 7, peers: bool = True,
+            log=print) -> dict:
+    """Every tool on `chain` and `states` at each optimisation level: agreement with apair first,
+    then `rounds` round-robin rounds (each program evaluates every operation over all poses once
+    per round); the minimum ns per evaluation over the rounds."""
+    workdir.mkdir(parents=True, exist_ok=True)
+    n = chain.n
+    inputs = workdir / f"inputs{n}.bin"
+    write_inputs(inputs, chain, states)
+    tools: dict[str, Path] = {}
+    result: dict = {"n": n, "count": states.count, "tools": {}, "skipped": {}}
+    casadi_c = None
+    if peers:
+        try:
+            log("  generating CasADi's C code from Pinocchio on casadi::SX ...")
+            casadi_c = casadi_generate(workdir, inputs)
+            result["casadi_ops"] = json.loads((casadi_c / "ops.json").read_text())
+        except (RuntimeError, subprocess.CalledProcessError) as exc:
+            result["skipped"]["casadi"] = str(exc)
+    for opt in opts:
+        log(f"  building at {opt} ...")
+        tools[f"apair {opt}"] = apair_build(chain, workdir, opt)
+        if peers:
+            try:
+                tools[f"pinocchio {opt}"] = pinocchio_build(workdir, opt)
+            except (RuntimeError, subprocess.CalledProcessError) as exc:
+                result["skipped"]["pinocchio"] = str(exc)
+            if casadi_c is not None:
+                tools[f"casadi_baked {opt}"] = casadi_build(workdir, casadi_c, n, False, opt)
+                tools[f"casadi_design {opt}"] = casadi_build(workdir, casadi_c, n, True, opt)
+    outputs = {}
+    for name, exe in tools.items():
+        run_program(exe, inputs, workdir / "out.bin", 1)
+        outputs[name] = read_outputs(workdir / "out.bin", n)
+    ref = outputs[f"apair {opts[0]}"]
+    best: dict[str, dict] = {name: {} for name in tools}
+    for r in range(rounds):
+        for name, exe in tools.items():
+            times = run_program(exe, inputs, workdir / "out.bin", 1)
+            for op, t in times.items():
+                if op != "sink":
+                    best[name][op] = min(best[name].get(op, np.inf), t)
+    for name in tools:
+        result["tools"][name] = {"ns": best[name], "difference": _agreement(ref, outputs[name])}
+    return result
