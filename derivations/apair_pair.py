@@ -238,31 +238,21 @@ def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
     }[kind])]
     u = sp.Symbol("u", real=True)
     C, S = sp.Symbol("C_half", real=True), sp.Symbol("S_half", real=True)
-    cos_t = sp.Symbol("cos_theta", real=True)
 
-    def in_half(e):
-        e = sp.expand_trig(sp.simplify(e).subs(theta, 2 * u))
-        e = e.subs({sp.cos(u): C, sp.sin(u): S})
-        assert e.free_symbols <= {C, S, h, a, b}, e
-        return e
+    def in_half(e, *extra):
+        """e(θ) in C, S: θ = 2u, the double-angle formulas, then cos u → C, sin u → S."""
+        e = sp.expand_trig(e.subs(theta, 2 * u)).subs({sp.cos(u): C, sp.sin(u): S})
+        assert e.free_symbols <= {C, S, h, a, b, *extra}, e
+        return sp.factor(e)
 
-    derivs = [d_expr, sp.diff(d_expr, theta), sp.diff(d_expr, theta, 2)]
+    derivs = [sp.simplify(e) for e in (d_expr, sp.diff(d_expr, theta), sp.diff(d_expr, theta, 2))]
     steps = [(C, sp.cos(theta / 2)), (S, sp.sin(theta / 2))]
     if kind == "general":
-        # d = √(a + b cos θ): keep the radicand as one step so that d, d', d'' share it
-        gap = sp.Symbol("gap", real=True)
-        steps += [(cos_t, C**2 - S**2), (gap, a + b * cos_t)]
-        dsym = sp.Symbol("d_general", real=True)
-        steps.append((dsym, sp.sqrt(gap)))
-        radicand = a + b * sp.cos(theta)
-        outs = []
-        for e in derivs:
-            e = sp.simplify(e).subs(sp.sqrt(radicand), dsym)
-            e = sp.expand_trig(e.subs(theta, 2 * u)).subs({sp.cos(u): C, sp.sin(u): S})
-            outs.append(sp.factor(e))
-        for e in outs:
-            assert e.free_symbols <= {C, S, dsym, a, b}, e
-        # the same values on the angle route, at a random point
+        # d = √(a + b cos θ) as one step, the radicand formed as a + b(C² − S²), shared by d', d''
+        cos_t, gap, dsym = (sp.Symbol(nm, real=True) for nm in ("cos_theta", "gap", "d_general"))
+        steps += [(cos_t, C**2 - S**2), (gap, a + b * cos_t), (dsym, sp.sqrt(gap))]
+        outs = [in_half(e.subs(sp.sqrt(a + b * sp.cos(theta)), dsym), dsym) for e in derivs]
+        # the same values on the angle route, at a rational point
         vals = {theta: sp.Rational(7, 10), a: sp.Rational(3, 10), b: sp.Rational(11, 10)}
         env = {C: sp.cos(vals[theta] / 2), S: sp.sin(vals[theta] / 2)}
         env[dsym] = sp.sqrt(vals[a] + vals[b] * (env[C]**2 - env[S]**2))
@@ -271,7 +261,7 @@ def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
     elif kind == "revolute":
         outs = [sp.S(0), sp.S(0), sp.S(0)]
     else:
-        outs = [sp.factor(in_half(e)) for e in derivs]
+        outs = [in_half(e) for e in derivs]
     return KernelSpec(
         name=f"law_{kind}",
         doc=(f"The {kind} pair's law values at theta: cos(theta/2), sin(theta/2), d(theta) and its first two "

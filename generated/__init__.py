@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 8807fcd79a4d6cd6
+Content hash: fbf32b51be239942
 """
