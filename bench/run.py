@@ -188,7 +188,7 @@ def bench_chain(n: int, rng, batch: int, single: int, slow: int, repeats: int, p
         name = f"{op}{n}"
         spec_j = kernels.manifest()["kernels"][name]
         row["kernel"] = name
-        row["ops"] = spec_j["ops"]
+        row["ops"] = spec_j["ops_per_item"]
         inputs = [per_pose.get(a["name"], design.get(a["name"])) for a in spec_j["inputs"]]
         one = lambda k: [x[k] if a["name"] in per_pose else x for x, a in zip(inputs, spec_j["inputs"])]
         row["c_batched"] = per_item(lambda: kernels.call(name, *inputs), batch, repeats)
