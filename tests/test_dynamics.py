@@ -95,6 +95,46 @@ def test_revolute_chain_equals_pinocchio(n, backend):
             np.testing.assert_allclose(chain.gravity_torques(q), pin.computeGeneralizedGravity(model, data, q), atol=1e-9)
 
 
+def special_chain(rng, n) -> apair.AChain:
+    """The constants real robots use: twists 0 and ±90°, lengths, offsets and angle offsets 0 or
+    round values (intersecting and parallel axes), sinusoidal A-pairs with massive legs and R-pairs."""
+    pairs = [apair.APair.revolute() if rng.random() < 0.4 else apair.APair(0.05, 0.04, leg_mass=0.1)
+             for _ in range(n)]
+    pick = lambda values: rng.choice(values, n)
+    return apair.AChain(pairs, pick([0.0, 0.1, 0.3]), pick([0.0, np.pi / 2, -np.pi / 2]), pick([0.0, 0.1]),
+                        pick([0.0, np.pi / 2]), links=[random_link(rng) for _ in range(n)], gravity=(0.0, 0.0, -9.81))
+
+
+@pytest.mark.parametrize("n", [2, 4, 6])
+def test_special_designs_equal_reduced_pinocchio(n, backend):
+    """Twists 0 and ±90°, zero lengths and offsets, joint values 0 and π (d = 0 for an A-pair),
+    legs with mass set to zero for Pinocchio's model: M, bias, τ and θ'' agree."""
+    rng = np.random.default_rng(300 + n)
+    for _ in range(6):
+        chain = special_chain(rng, n)
+        plain = apair.AChain([apair.APair(0.05, 0.04) if p.kind != "revolute" else p for p in chain.pairs],
+                             chain.a, chain.alpha, chain.offset, chain.theta_offset, links=chain.links,
+                             gravity=chain.gravity)
+        model = pinocchio_model(plain)
+        data = model.createData()
+        for _ in range(3):
+            q = rng.choice([0.0, np.pi, -np.pi, 0.5, -2.0], n)
+            qd, qdd = rng.normal(size=n), rng.normal(size=n)
+            qf, S, Sdqd = reduced(plain, q, qd, qdd)
+            Mf = pin.crba(model, data, qf)
+            M = S.T @ (np.triu(Mf) + np.triu(Mf, 1).T) @ S
+            bias = S.T @ pin.rnea(model, data, qf, S @ qd, Sdqd)
+            np.testing.assert_allclose(plain.mass_matrix(q), M, atol=1e-9)
+            np.testing.assert_allclose(plain.bias(q, qd), bias, atol=1e-9)
+            np.testing.assert_allclose(plain.inverse_dynamics(q, qd, qdd), M @ qdd + bias, atol=1e-9)
+            np.testing.assert_allclose(plain.forward_dynamics(q, qd, M @ qdd + bias), qdd, atol=1e-7)
+            # the legs only add: their mass matrix is the plain one plus a positive semidefinite part
+            extra = np.linalg.eigvalsh(chain.mass_matrix(q) - plain.mass_matrix(q))
+            assert extra.min() > -1e-12
+            np.testing.assert_allclose(chain.forward_dynamics(q, qd, chain.inverse_dynamics(q, qd, qdd)), qdd,
+                                       atol=1e-7)
+
+
 @pytest.mark.parametrize("n", N_RANGE)
 def test_apair_chain_equals_reduced_pinocchio(n, backend):
     rng = np.random.default_rng(200 + n)
