@@ -61,6 +61,11 @@ class Hoisted:
     core: list[tuple[str, str]]
     core_ops: int  # operations per item of a batch that shares its design
 
+    @property
+    def loads(self) -> list[tuple[str, str]]:
+        """The core's reads of the stored invariants: (name, "inv[k]")."""
+        return [(name, f"inv[{k}]") for k, name in enumerate(self.stored)]
+
 
 @dataclass
 class LoweredCall:

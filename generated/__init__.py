@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: fbf32b51be239942
+Content hash: 951d2452e461a5eb
 """
