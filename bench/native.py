@@ -58,40 +58,8 @@ def write_inputs(path: Path, chain, states: States) -> None:
     np.concatenate([np.ascontiguousarray(p, dtype=np.float64).ravel() for p in parts]).tofile(path)
 
 
-READER = r"""
-static double *Q, *QD, *QDD, *TAU, DH[24], LINKS[60], LEGS[18], GRAV[3], LAWP[6];
-static long COUNT;
-static int N;
+PEERS = ROOT / "bench" / "peers"  # bench_inputs.h: the input file's reader, shared by every program
 
-static int read_inputs(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    double head[2];
-    long k;
-    if (!f || fread(head, sizeof(double), 2, f) != 2) return 1;
-    COUNT = (long)head[0];
-    N = (int)head[1];
-    Q = (double *)malloc(sizeof(double) * COUNT * N);
-    QD = (double *)malloc(sizeof(double) * COUNT * N);
-    QDD = (double *)malloc(sizeof(double) * COUNT * N);
-    TAU = (double *)malloc(sizeof(double) * COUNT * N);
-    k = COUNT * N;
-    if (fread(Q, sizeof(double), k, f) != (size_t)k || fread(QD, sizeof(double), k, f) != (size_t)k
-        || fread(QDD, sizeof(double), k, f) != (size_t)k || fread(TAU, sizeof(double), k, f) != (size_t)k
-        || fread(DH, sizeof(double), 4 * N, f) != (size_t)(4 * N) || fread(LINKS, sizeof(double), 10 * N, f) != (size_t)(10 * N)
-        || fread(LEGS, sizeof(double), 3 * N, f) != (size_t)(3 * N) || fread(GRAV, sizeof(double), 3, f) != 3
-        || fread(LAWP, sizeof(double), N, f) != (size_t)N) return 1;
-    fclose(f);
-    return 0;
-}
-
-static double now_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec * 1e9 + t.tv_nsec;
-}
-"""
 
 
 def apair_program(chain) -> str:
@@ -107,13 +75,11 @@ def apair_program(chain) -> str:
     half = "\n            ".join(f"acc += cos(0.5 * q[{i}]) + sin(0.5 * q[{i}]);" for i in range(n))
     ops_code = []
     for op, (stem, extra, size) in OPERATIONS.items():
-        args = ["LAW", "0" if False else f"{5 * n}"]
         call_inputs = [f"LAW, {5 * n}"]
         for name in extra:
             call_inputs.append(f"{name.upper()}, {n}")
         design = {"fk": ["DH, 0"], "jacobian": ["DH, 0"], "mass_matrix": ["DH, 0", "LINKS, 0", "LEGS, 0"]}.get(
             op, ["DH, 0", "LINKS, 0", "LEGS, 0", "GRAV, 0"])
-        del args
         ops_code.append((op, f"apair_{stem}{n}_batch((size_t)COUNT, {', '.join(call_inputs + design)}, OUT_{op});",
                          size(n)))
     body = []
@@ -137,7 +103,8 @@ def apair_program(chain) -> str:
 #include <time.h>
 
 #include "apair.h"
-{READER}
+#include "bench_inputs.h"
+
 static double *LAW;
 {outs}
 
@@ -232,7 +199,7 @@ def apair_build(chain, workdir: Path, opt: str) -> Path:
     kernels = [f"{stem}{n}" for stem, _, _ in OPERATIONS.values()]
     kernels += sorted({p.law_kernel[0] for p in chain.pairs})
     exe = workdir / f"apair{n}_{'_'.join(sorted({p.law_kernel[0][4:] for p in chain.pairs}))}{opt}"
-    compile_c(apair_program(chain), exe, [opt, f"-I{c_dir}"], [str(c_dir / f"{k}.c") for k in kernels] + ["-lm"])
+    compile_c(apair_program(chain), exe, [opt, f"-I{c_dir}", f"-I{PEERS}"], [str(c_dir / f"{k}.c") for k in kernels] + ["-lm"])
     return exe
 
 
@@ -268,12 +235,13 @@ def pinocchio_build(workdir: Path, opt: str) -> Path:
     if prefix is None or not (prefix / "include" / "eigen3").is_dir():
         raise RuntimeError("Pinocchio's C++ headers or Eigen are missing: pip install '.[bench]'")
     exe = workdir / f"pinocchio{opt}"
-    source = ROOT / "bench" / "peers" / "pinocchio_timing.cpp"
+    source = PEERS / "pinocchio_timing.cpp"
     # Pinocchio's own compile definitions for Boost (its CMake config), but not its
     # PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION: the algorithms are compiled here, with these flags
     cmd = ["g++", "-std=c++17", opt, "-DNDEBUG", *BOOST_DEFINES, f"-I{prefix / 'include'}",
-           f"-I{prefix / 'include' / 'eigen3'}", str(source), "-o", str(exe)]
-    return cached(exe, cmd + [source.read_text(), str(prefix)], lambda: subprocess.run(cmd, check=True))
+           f"-I{prefix / 'include' / 'eigen3'}", f"-I{PEERS}", str(source), "-o", str(exe)]
+    key = cmd + [source.read_text(), (PEERS / "bench_inputs.h").read_text(), str(prefix)]
+    return cached(exe, key, lambda: subprocess.run(cmd, check=True))
 
 
 def casadi_dirs() -> tuple[Path, Path] | None:
@@ -296,10 +264,10 @@ def casadi_generate(workdir: Path, inputs: Path) -> Path:
         raise RuntimeError("Pinocchio's headers or the casadi wheel are missing: pip install '.[bench]'")
     include, lib = dirs
     exe = workdir / "casadi_codegen"
-    source = ROOT / "bench" / "peers" / "casadi_codegen.cpp"
+    source = PEERS / "casadi_codegen.cpp"
     cmd = ["g++", "-std=c++17", "-O1", *BOOST_DEFINES, f"-I{prefix / 'include'}", f"-I{prefix / 'include' / 'eigen3'}",
-           f"-I{include}", str(source), f"-L{lib}", "-lcasadi", f"-Wl,-rpath,{lib}", "-o", str(exe)]
-    cached(exe, cmd + [source.read_text()], lambda: subprocess.run(cmd, check=True))
+           f"-I{include}", f"-I{PEERS}", str(source), f"-L{lib}", "-lcasadi", f"-Wl,-rpath,{lib}", "-o", str(exe)]
+    cached(exe, cmd + [source.read_text(), (PEERS / "bench_inputs.h").read_text()], lambda: subprocess.run(cmd, check=True))
     out = workdir / f"casadi_c_{inputs.stem}"
     out.mkdir(exist_ok=True)
     res = subprocess.run([str(exe), str(inputs.resolve()), str(out)], check=True, cwd=out, capture_output=True, text=True)
@@ -349,7 +317,8 @@ def casadi_program(n: int, prefix: str) -> str:
 #include <time.h>
 
 #include "{'pin_design.h' if design else 'pin_baked.h'}"
-{READER}
+#include "bench_inputs.h"
+
 {chr(10).join(outs)}
 
 int main(int argc, char **argv)
@@ -375,7 +344,7 @@ def casadi_build(workdir: Path, c_dir: Path, n: int, design: bool, opt: str) -> 
     prefix = "pind_" if design else "pin_"
     exe = workdir / f"casadi_{'design' if design else 'baked'}{n}{opt}"
     source = c_dir / f"pin_{'design' if design else 'baked'}.c"
-    compile_c(casadi_program(n, prefix), exe, [opt, f"-I{c_dir}"], [str(source), "-lm"])
+    compile_c(casadi_program(n, prefix), exe, [opt, f"-I{c_dir}", f"-I{PEERS}"], [str(source), "-lm"])
     return exe
 
 

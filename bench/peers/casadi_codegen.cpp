@@ -15,9 +15,10 @@
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/multibody.hpp>
 
-#include <cstdio>
 #include <string>
 #include <vector>
+
+#include "bench_inputs.h"
 
 using namespace pinocchio;
 typedef ::casadi::SX ADScalar;
@@ -27,26 +28,6 @@ typedef Eigen::Matrix<ADScalar, Eigen::Dynamic, 1> ADVector;
 typedef Eigen::Matrix<ADScalar, 3, 3> ADMatrix3;
 typedef Eigen::Matrix<ADScalar, 3, 1> ADVector3;
 typedef SE3Tpl<ADScalar> ADSE3;
-
-static double DH[24], LINKS[60], GRAV[3];
-static int N;
-
-static bool read_design(const char *path)
-{
-    FILE *f = std::fopen(path, "rb");
-    double head[2];
-    if (!f || std::fread(head, sizeof(double), 2, f) != 2) return false;
-    const long count = (long)head[0];
-    N = (int)head[1];
-    std::fseek(f, (long)(sizeof(double) * (2 + 4 * count * N)), SEEK_SET);
-    double legs[18];
-    bool ok = std::fread(DH, sizeof(double), 4 * N, f) == (size_t)(4 * N)
-              && std::fread(LINKS, sizeof(double), 10 * N, f) == (size_t)(10 * N)
-              && std::fread(legs, sizeof(double), 3 * N, f) == (size_t)(3 * N)
-              && std::fread(GRAV, sizeof(double), 3, f) == 3;
-    std::fclose(f);
-    return ok;
-}
 
 // Rz(phi) Tz(c) Tx(a) Rx(alpha) in scalar S
 template <typename S>
@@ -167,7 +148,7 @@ static void add_functions(::casadi::CodeGenerator &gen, ADModel &model, const st
 
 int main(int argc, char **argv)
 {
-    if (argc < 3 || !read_design(argv[1])) return 2;
+    if (argc < 3 || read_inputs(argv[1])) return 2;
     const std::string dir = std::string(argv[2]) + "/";
     // baked: the numeric model cast to SX
     {

@@ -12,43 +12,11 @@
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/multibody.hpp>
 
-#include <cstdio>
-#include <cstdlib>
-#include <ctime>
 #include <vector>
 
+#include "bench_inputs.h"
+
 using namespace pinocchio;
-
-static std::vector<double> Q, QD, QDD, TAU;
-static double DH[24], LINKS[60], LEGS[18], GRAV[3], LAWP[6];
-static long COUNT;
-static int N;
-
-static bool read_inputs(const char *path)
-{
-    FILE *f = std::fopen(path, "rb");
-    double head[2];
-    if (!f || std::fread(head, sizeof(double), 2, f) != 2) return false;
-    COUNT = (long)head[0];
-    N = (int)head[1];
-    const size_t k = (size_t)(COUNT * N);
-    Q.resize(k); QD.resize(k); QDD.resize(k); TAU.resize(k);
-    bool ok = std::fread(Q.data(), sizeof(double), k, f) == k && std::fread(QD.data(), sizeof(double), k, f) == k
-              && std::fread(QDD.data(), sizeof(double), k, f) == k && std::fread(TAU.data(), sizeof(double), k, f) == k
-              && std::fread(DH, sizeof(double), 4 * N, f) == (size_t)(4 * N)
-              && std::fread(LINKS, sizeof(double), 10 * N, f) == (size_t)(10 * N)
-              && std::fread(LEGS, sizeof(double), 3 * N, f) == (size_t)(3 * N) && std::fread(GRAV, sizeof(double), 3, f) == 3
-              && std::fread(LAWP, sizeof(double), N, f) == (size_t)N;
-    std::fclose(f);
-    return ok;
-}
-
-static double now_ns()
-{
-    timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec * 1e9 + t.tv_nsec;
-}
 
 static SE3 rot(int axis, double angle)
 {
@@ -84,7 +52,7 @@ static Model build_model()
 
 int main(int argc, char **argv)
 {
-    if (argc < 4 || !read_inputs(argv[1])) return 2;
+    if (argc < 4 || read_inputs(argv[1])) return 2;
     const int rounds = std::atoi(argv[3]);
     Model model = build_model();
     Data data(model);
