@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 951d2452e461a5eb
+Content hash: 4cd7e5652fe13d9b
 """
