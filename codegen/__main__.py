@@ -8,13 +8,13 @@ and prints its kernels in a worker process; the results are put back in the cano
 from __future__ import annotations
 
 import argparse
-import importlib
 import os
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from . import derivation
 from .emitter import Emitter, OutputError, lower, render_polynomials, write
 
 DERIVATIONS = ("apair_collisions", "apair_pair", "apair_dynamics", "chain_kinematics", "chain_dynamics",
@@ -30,7 +30,7 @@ def jobs(names) -> list[tuple[str, object]]:
     """(derivation, part) pairs in canonical order; part None for a derivation without PARTS."""
     out = []
     for name in names:
-        module = importlib.import_module(f"derivations.{name}")
+        module = derivation(name)
         out += [(name, part) for part in getattr(module, "PARTS", (None,))]
     return out
 
@@ -38,7 +38,7 @@ def jobs(names) -> list[tuple[str, object]]:
 def run_job(name: str, part) -> tuple[float, dict[str, str], list]:
     """Derive one job and lower its kernels: (seconds, polynomial files, lowered kernels)."""
     t0 = time.perf_counter()
-    module = importlib.import_module(f"derivations.{name}")
+    module = derivation(name)
     sets, specs, _facts = module.derive() if part is None else module.derive(part)
     return time.perf_counter() - t0, render_polynomials(sets), [lower(s) for s in specs]
 

@@ -18,15 +18,29 @@ from pathlib import Path
 import jinja2
 import sympy as sp
 
-from derivations.spec import Arg, KernelSpec, PolynomialSet
-
+from . import derivation
 from .printers import CPrinter, NumpyPrinter
 from .polynomials import render_polynomial_set
+
+_spec = derivation("spec")
+Arg, KernelSpec, PolynomialSet = _spec.Arg, _spec.KernelSpec, _spec.PolynomialSet
 
 TEMPLATES = Path(__file__).parent / "templates"
 PREFIX = "apair_"
 # The package version, stamped into the C library (header, CMake, pkg-config).
-VERSION = tomllib.loads((Path(__file__).resolve().parent.parent / "pyproject.toml").read_text())["project"]["version"]
+
+
+def _version() -> str:
+    """The package version: from pyproject.toml in the source tree, else the installed apair's."""
+    project = Path(__file__).resolve().parent.parent / "pyproject.toml"
+    if project.is_file():
+        return tomllib.loads(project.read_text())["project"]["version"]
+    from importlib.metadata import version
+
+    return version("apair")
+
+
+VERSION = _version()
 
 
 @dataclass
@@ -261,7 +275,11 @@ class Emitter:
         self.env.filters["dims"] = lambda a: ", ".join(str(d) for d in (tuple(a.shape) + (0, 0, 0))[:3])
 
     def _template(self, name: str) -> tuple[jinja2.Template, str]:
-        return self.env.get_template(name), (TEMPLATES / name).read_text()
+        """The template and its text (with the shared C macros' text for a C template), for hashes."""
+        text = (TEMPLATES / name).read_text()
+        if '"c_macros.j2"' in text:
+            text += (TEMPLATES / "c_macros.j2").read_text()
+        return self.env.get_template(name), text
 
     def render(self, lowered: dict[str, list[Lowered]], poly_files: dict[str, str]) -> dict[str, str]:
         """lowered: {derivation module stem: its lowered kernels}; poly_files: the rendered
@@ -331,6 +349,37 @@ class Emitter:
         manifest["files"] = sorted(set(files) | {"manifest.json"})  # what a later run may replace or remove
         files["manifest.json"] = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
         return files
+
+
+    def render_chain(self, kernels: list[Lowered], name: str, meta: dict, tests: list[dict]) -> dict[str, str]:
+        """The code of one chain with its design built in (derivations/specialised.py): name.h,
+        name.c, name.py, name_selftest.c, CMakeLists.txt, name.pc.in and manifest.json;
+        `meta`: title, origin (the chain file), joints, ranges, n, hash; `tests`: per kernel checked
+        {kernel (Lowered), inputs: [(Arg, values)], outputs: [(Arg, values)]}, values as C literals."""
+        for k in kernels:
+            if k.calls or k.hoisted:
+                raise ValueError(f"{k.name}: a specialised kernel has no calls and no design inputs")
+        ctx = dict(meta, name=name, kernels=kernels, version=VERSION, guard=f"{name.upper()}_H")
+        files = {}
+        for template, out in (("chain.h.j2", f"{name}.h"), ("chain.c.j2", f"{name}.c"),
+                              ("chain_CMakeLists.txt.j2", "CMakeLists.txt"), ("chain.pc.in.j2", f"{name}.pc.in")):
+            files[out] = self._template(template)[0].render(**ctx)
+        count = len(tests[0]["inputs"][0][1]) // tests[0]["inputs"][0][0].size if tests else 0
+        files[f"{name}_selftest.c"] = self._template("chain_selftest.c.j2")[0].render(**ctx, count=count, tests=tests)
+        files[f"{name}.py"] = self._template("kernels.py.j2")[0].render(
+            kernels=kernels, source=meta["origin"], hash=meta["hash"],
+            constants=[("N", meta["n"]), ("CONTENT_HASH", repr(meta["hash"]))])
+        manifest = {"content_hash": meta["hash"], "prefix": name, "n": meta["n"], "origin": meta["origin"],
+                    "kernels": {k.name: {"inputs": [{"name": a.name, "shape": list(a.shape)} for a in k.spec.inputs],
+                                         "outputs": [{"name": a.name, "shape": list(a.shape)} for a in k.spec.outputs],
+                                         "ops": k.ops} for k in kernels}}
+        manifest["files"] = sorted(set(files) | {"manifest.json"})
+        files["manifest.json"] = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
+        return files
+
+    def render_chain_registry(self, kernels: list[Lowered], name: str, hash: str) -> str:
+        """The registry of a specialised chain's kernels in apair.h's form (for the runtime)."""
+        return self._template("chain_registry.c.j2")[0].render(kernels=kernels, name=name, hash=hash)
 
 
 def _ops_per_item(k: Lowered, by_name: dict) -> int:

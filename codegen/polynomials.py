@@ -7,7 +7,10 @@ from pathlib import Path
 import jinja2
 import sympy as sp
 
-from derivations.spec import Entry, PolynomialSet
+from . import derivation
+
+_spec = derivation("spec")
+Entry, PolynomialSet = _spec.Entry, _spec.PolynomialSet
 
 TEMPLATES = Path(__file__).parent / "templates"
 

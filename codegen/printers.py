@@ -24,6 +24,12 @@ def _small_power(printer, expr) -> str | None:
     return None
 
 
+def _float(expr) -> str:
+    """A Float (a design constant folded at generation time) as the shortest literal that reads
+    back as its nearest double."""
+    return repr(float(expr))
+
+
 class CPrinter(C99CodePrinter):
     """C99 without M_PI and friends (not in strict C99): constants print as decimal literals."""
 
@@ -38,6 +44,9 @@ class CPrinter(C99CodePrinter):
     _print_Pi = _print_NumberSymbol
     _print_Exp1 = _print_NumberSymbol
 
+    def _print_Float(self, expr):
+        return _float(expr)
+
     def _print_Pow(self, expr):
         return _small_power(self, expr) or super()._print_Pow(expr)
 
@@ -47,6 +56,9 @@ class NumpyPrinter(NumPyPrinter):
 
     def __init__(self):
         super().__init__({"fully_qualified_modules": True, "inline": True})
+
+    def _print_Float(self, expr):
+        return _float(expr)
 
     def _print_Pow(self, expr, rational=False):
         return _small_power(self, expr) or super()._print_Pow(expr, rational=rational)

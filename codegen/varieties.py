@@ -13,10 +13,12 @@ import sys
 import time
 from pathlib import Path
 
-from derivations.spec import Entry, PolynomialSet
-
+from . import derivation
 from .emitter import OutputError, content_hash, write
 from .polynomials import render_polynomial_set
+
+_spec = derivation("spec")
+Entry, PolynomialSet = _spec.Entry, _spec.PolynomialSet
 
 ROOT = Path(__file__).resolve().parent.parent
 PREFIX = "variety_"

@@ -159,12 +159,8 @@ def derive():
     mobility = mobility_certificate()
 
     # --- laws and their derivatives, for the kernels ---------------------------------------------
-    laws = {
-        "revolute": (sp.S(0), (theta,)),
-        "sinusoidal": (d_sinus, (theta, h)),
-        "general": (d_general, (theta, a, b)),
-    }
-    specs = [law_spec(kind, expr, args) for kind, (expr, args) in laws.items()]
+    assert LAWS["sinusoidal"][0] == d_sinus and LAWS["general"][0] == d_general
+    specs = law_specs()
     specs.append(legs_spec())
     L2_sq = sp.expand(L1**2 - L1_sq + L2**2)  # L2² from the consistency condition
     specs += design_specs(a_expr, b_expr, L2_sq, sinus_L1, h_expr)
@@ -219,6 +215,19 @@ def derive():
         "mobility": mobility,
     }
     return [gdp, motion], specs, facts
+
+
+# d(θ) of each kind and the law kernel's inputs: the forms derive() proves from the pair's quadric.
+LAWS = {
+    "revolute": (sp.S(0), (theta,)),
+    "sinusoidal": (SINUSOIDAL_LAW, (theta, h)),
+    "general": (sp.sqrt(a + b * sp.cos(theta)), (theta, a, b)),
+}
+
+
+def law_specs() -> list[KernelSpec]:
+    """The law kernels of the three kinds (derive() checks LAWS against the derivation)."""
+    return [law_spec(kind, expr, args) for kind, (expr, args) in LAWS.items()]
 
 
 def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:

@@ -36,6 +36,7 @@ def test_missing_library_falls_back_once(monkeypatch):
     monkeypatch.setattr(kernels, "_native", lambda: (None, "the compiled C kernels are gone (test)"))
     monkeypatch.setitem(kernels._state, "warned", False)
     monkeypatch.setitem(kernels._state, "resolved", None)
+    chain = apair.AChain(chain.pairs, chain.a, chain.alpha)  # built without the C kernels: no fast path
     with pytest.warns(RuntimeWarning, match="using the NumPy kernels"):
         first = chain.fk(q)
     with warnings.catch_warnings():

@@ -13,12 +13,16 @@ import math
 import numpy as np
 
 from . import _validate as V
-from .kernels import call
+from .kernels import call, native_chain
 from .link import Link
 from .pair import APair
 from .study import normalise
 
 MAX_JOINTS = 6
+# The kernel-backed methods in the order of their native fast path (apair.kernels.native_chain):
+# (kernel family, whether a joint at its range end is refused because d' is unbounded there).
+METHODS = (("fk", False), ("fk_study", False), ("jacobian", True), ("mass_matrix", True), ("coriolis", True),
+           ("gravity", True), ("bias", True), ("inverse_dynamics", True), ("forward_dynamics", True), ("energy", True))
 
 
 class AChain:
@@ -59,10 +63,21 @@ class AChain:
         self.gravity = V.vector("gravity", gravity, 3)
         self._links = np.ascontiguousarray(np.stack([link.as_row() for link in links]))
         self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pairs])
+        self._gravity = np.ascontiguousarray(self.gravity)
         self._law_groups = self._group_laws()
         self._ranged = [i for i, p in enumerate(pairs) if p.theta_limit is not None]  # angles to check
         self._ik = None  # the inverse-kinematics solver, built on the first call of ik()
         self._explicit_limits = self._check_limits(limits)
+        self._fast = self._native_chain()
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        del state["_fast"]  # a native object: rebuilt on unpickling
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._fast = self._native_chain()
 
     def _check_limits(self, limits):
         if limits is None:
@@ -130,98 +145,145 @@ class AChain:
                                                    for k in range(values.shape[1])]))
         return groups
 
+    def _native_chain(self, kernel=lambda family, n: f"{family}{n}", law: bool = True):
+        """The native fast path of the methods (apair.kernels.native_chain): per method the
+        kernel `kernel(family, n)`, fed by the pairs' law kernels when `law`."""
+        return native_chain(
+            self.n, [(kernel(family, self.n), strict) for family, strict in METHODS],
+            [p.law_kernel for p in self.pairs] if law else [],
+            [p.theta_limit if p.theta_limit is not None else math.inf for p in self.pairs],
+            {"dh": self._dh, "links": self._links, "legs": self._legs, "gravity": self._gravity})
+
     def law(self, q) -> np.ndarray:
         """(..., n, 3): each joint's (d, d', d'') at q."""
-        return self._law(self._q(q))[..., 2:]
+        return self._law(self._snapped(self._q(q)))[..., 2:]
 
-    def _law(self, q: np.ndarray) -> np.ndarray:
-        """(..., n, 5): the chain kernels' law input (cos(θ/2), sin(θ/2), d, d', d'') of a
-        validated q; each pair with a restricted range checks its angles."""
-        for i in self._ranged:  # angles past the range end by rounding are put on it
+    def _snapped(self, q: np.ndarray) -> np.ndarray:
+        """A validated q with the angles past a range end by rounding put on it (each pair with
+        a restricted range checks its angles)."""
+        for i in self._ranged:
             snapped = self.pairs[i]._theta(q[..., i], name=f"q[..., {i}]")
             if not np.array_equal(snapped, q[..., i]):
                 q = q.copy()
                 q[..., i] = snapped
+        return q
+
+    def _law(self, q: np.ndarray) -> np.ndarray:
+        """(..., n, 5): the chain kernels' law input (cos(θ/2), sin(θ/2), d, d', d'') of a
+        validated, snapped q."""
         out = np.empty(q.shape + (5,))
         for kernel, idx, params in self._law_groups:
             out[..., idx, :] = call(kernel, q[..., idx, None], *params)[0]
         return out
 
-    def _kernel(self, stem: str, q):
-        q = self._q(q)
-        return call(f"{stem}{self.n}", self._law(q), self._dh)[0]
-
-    def fk(self, q) -> np.ndarray:
-        """(..., 4, 4): the pose of frame n in the base frame; q is (n,) or (..., n)."""
-        return self._kernel("fk", q)
-
-    def fk_study(self, q) -> np.ndarray:
-        """(..., 8): the Study point (x0..x3, y0..y3) of fk(q), with |x| = 1; (x, y) ~ (−x, −y)."""
-        return normalise(self._kernel("fk_study", q))
-
-    def jacobian(self, q) -> np.ndarray:
-        """(..., 6, n): geometric Jacobian, base frame, rows [v; ω] (v of the origin of frame n)."""
-        _, law = self._state(q)
-        return call(f"jacobian{self.n}", law, self._dh)[0]
-
-    # ----------------------------------------------------------------------------- dynamics
-    def _state(self, q, **named):
-        """Validated q and the named (n,)-arrays (qd, qdd, tau), broadcast to one batch shape; and
-        the joint law values at q."""
-        q = self._q(q)
+    def _state(self, q, strict: bool = True, **named) -> list[np.ndarray]:
+        """Validated, snapped q and the named (n,)-arrays (qd, qdd, tau), broadcast to one batch
+        shape, C-contiguous; with `strict`, a joint at its range end (where d' is unbounded) is
+        refused."""
+        q = self._snapped(self._q(q))
+        if not named:
+            return [np.ascontiguousarray(q)] + ([] if not strict else self._refuse_range_ends(q))
         arrays = [q] + [self._q(x, name) for name, x in named.items()]
         try:
             shape = np.broadcast_shapes(*(x.shape for x in arrays))
         except ValueError:
             first = next(iter(named))
             raise ValueError(f"{first}: batch shape does not match q: {[x.shape for x in arrays]}") from None
-        arrays = [x if x.shape == shape else np.broadcast_to(x, shape) for x in arrays]
-        law = self._law(arrays[0])
-        for i in self._ranged:  # at the range end (up to rounding) d' is unbounded
-            t = arrays[0][..., i]
-            t = np.abs(t - 2 * np.pi * np.round(t / (2 * np.pi)))
-            if np.any(t >= self.pairs[i].theta_limit) or not np.isfinite(law[..., i, :]).all():
-                raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
-        return arrays, law
+        arrays = [np.ascontiguousarray(np.broadcast_to(x, shape)) for x in arrays]
+        return arrays + (self._refuse_range_ends(arrays[0]) if strict else [])
 
+    def _refuse_range_ends(self, q: np.ndarray) -> list:
+        """Refuses a joint at its range end (up to rounding), where d' is unbounded; returns []."""
+        for i in self._ranged:
+            t = q[..., i]
+            t = np.abs(t - 2 * np.pi * np.round(t / (2 * np.pi)))
+            if np.any(t >= self.pairs[i].theta_limit):
+                raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
+        return []
+
+    def _evaluate(self, method: int, family: str, q, design, strict: bool = True, **named) -> np.ndarray:
+        """The validating path of a method: checks and converts the inputs (a ValueError names
+        the argument), then the fast path again, else the law kernels and the generic kernel of
+        `family` with the `design` inputs after the state."""
+        arrays = self._state(q, strict, **named)
+        out = self._fast.call(method, *arrays)
+        if out is None:
+            law = self._law(arrays[0])
+            if strict and not np.isfinite(law).all():
+                raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
+            out = call(f"{family}{self.n}", law, *arrays[1:], *design)[0]
+        return out
+
+    def fk(self, q) -> np.ndarray:
+        """(..., 4, 4): the pose of frame n in the base frame; q is (n,) or (..., n)."""
+        out = self._fast.call(0, q)
+        return out if out is not None else self._evaluate(0, "fk", q, (self._dh,), strict=False)
+
+    def fk_study(self, q) -> np.ndarray:
+        """(..., 8): the Study point (x0..x3, y0..y3) of fk(q), with |x| = 1; (x, y) ~ (−x, −y)."""
+        out = self._fast.call(1, q)
+        return normalise(out if out is not None else self._evaluate(1, "fk_study", q, (self._dh,), strict=False))
+
+    def jacobian(self, q) -> np.ndarray:
+        """(..., 6, n): geometric Jacobian, base frame, rows [v; ω] (v of the origin of frame n)."""
+        out = self._fast.call(2, q)
+        return out if out is not None else self._evaluate(2, "jacobian", q, (self._dh,))
+
+    # ----------------------------------------------------------------------------- dynamics
     def mass_matrix(self, q) -> np.ndarray:
         """(..., n, n): M(θ), legs included."""
-        _, law = self._state(q)
-        return call(f"mass_matrix{self.n}", law, self._dh, self._links, self._legs)[0]
+        out = self._fast.call(3, q)
+        return out if out is not None else self._evaluate(3, "mass_matrix", q, self._body[:3])
 
     def coriolis_matrix(self, q, qd) -> np.ndarray:
         """(..., n, n): C(θ, θ') in Christoffel form (Ṁ − 2C is skew-symmetric)."""
-        (_, qd), law = self._state(q, qd=qd)
-        return call(f"coriolis{self.n}", law, qd, self._dh, self._links, self._legs)[0]
+        out = self._fast.call(4, q, qd)
+        return out if out is not None else self._evaluate(4, "coriolis", q, self._body[:3], qd=qd)
 
     def gravity_torques(self, q) -> np.ndarray:
         """(..., n): g(θ) = ∂V/∂θ."""
-        _, law = self._state(q)
-        return call(f"gravity{self.n}", law, self._dh, self._links, self._legs, self.gravity)[0]
+        out = self._fast.call(5, q)
+        return out if out is not None else self._evaluate(5, "gravity", q, self._body)
 
     def bias(self, q, qd) -> np.ndarray:
         """(..., n): C(θ, θ')θ' + g(θ)."""
-        (_, qd), law = self._state(q, qd=qd)
-        return call(f"bias{self.n}", law, qd, self._dh, self._links, self._legs, self.gravity)[0]
+        out = self._fast.call(6, q, qd)
+        return out if out is not None else self._evaluate(6, "bias", q, self._body, qd=qd)
 
     def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
         """(..., n): τ = M(θ)θ'' + C(θ, θ')θ' + g(θ), torques about the pair axes."""
-        (_, qd, qdd), law = self._state(q, qd=qd, qdd=qdd)
-        return call(f"inverse_dynamics{self.n}", law, qd, qdd, self._dh, self._links, self._legs, self.gravity)[0]
+        out = self._fast.call(7, q, qd, qdd)
+        return out if out is not None else self._evaluate(7, "inverse_dynamics", q, self._body, qd=qd, qdd=qdd)
 
     def forward_dynamics(self, q, qd, tau) -> np.ndarray:
         """(..., n): θ'' = M⁻¹(τ − C θ' − g), by a Cholesky factorisation of M inside one kernel."""
-        (_, qd, tau), law = self._state(q, qd=qd, tau=tau)
-        qdd = call(f"forward_dynamics{self.n}", law, qd, tau, self._dh, self._links, self._legs, self.gravity)[0]
-        if not np.isfinite(qdd).all():
-            raise ValueError("links: the mass matrix is not positive definite at this q "
-                             "(give every moving body mass and inertia)")
-        return qdd
+        out = self._fast.call(8, q, qd, tau)
+        if out is None:
+            out = self._evaluate(8, "forward_dynamics", q, self._body, qd=qd, tau=tau)
+            if not np.isfinite(out).all():
+                raise ValueError("links: the mass matrix is not positive definite at this q "
+                                 "(give every moving body mass and inertia)")
+        return out
 
     def energy(self, q, qd) -> np.ndarray:
         """(..., 2): kinetic and potential energy (T, V) [J], legs included."""
-        (_, qd), law = self._state(q, qd=qd)
-        return call(f"energy{self.n}", law, qd, self._dh, self._links, self._legs, self.gravity)[0]
+        out = self._fast.call(9, q, qd)
+        return out if out is not None else self._evaluate(9, "energy", q, self._body, qd=qd)
+
+    @property
+    def _body(self) -> tuple[np.ndarray, ...]:
+        return self._dh, self._links, self._legs, self._gravity
+
+    def specialise(self, kernels=None) -> "AChain":
+        """This chain with its design built into its own kernels (`apair codegen`'s C, compiled
+        once into the cache, see apair.specialise.cache_root, and found again by content hash):
+        the same methods, faster. `kernels`: a subset of fk, fk_study, jacobian, mass_matrix,
+        coriolis, gravity_torques, bias, inverse_dynamics, forward_dynamics, energy (default: all;
+        the others stay generic). Without a C compiler it warns once and uses the generic kernels
+        (`.specialised` says which)."""
+        from .specialise import SpecialisedChain
+
+        return SpecialisedChain(self, kernels)
 
     def simulate(self, q0, qd0, t, tau=None, rtol=1e-10, atol=1e-12, method="DOP853", limits="stop"):
         """Integrate the equations of motion from (q0, qd0) and report the state at times `t`.

@@ -181,6 +181,22 @@ def _cmd_kernels(args) -> int:
     return 0
 
 
+def _cmd_codegen(args) -> int:
+    import time
+
+    from . import specialise
+
+    t0 = time.perf_counter()
+    chain = load(args.file)
+    name = specialise.check_prefix(args.prefix) if args.prefix else specialise.prefix_from(args.file)
+    kernels = None if args.kernels is None else [k.strip() for k in args.kernels.split(",") if k.strip()]
+    changed = specialise.write_code(chain, args.out, name, os.path.basename(args.file), kernels,
+                                    title=chain.name)
+    print(f"apair codegen: {name} ({chain.n} joints) in {args.out}: {len(changed)} files written or changed "
+          f"({time.perf_counter() - t0:.1f} s)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="apair", description="Kinematics of A-pairs and A-chains.")
     ap.add_argument("--version", action="version", version=f"apair {__version__}")
@@ -224,6 +240,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on a dask.distributed scheduler (or 'threads', 'processes')")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_workspace)
+    p = sub.add_parser("codegen", help="C and NumPy code for one chain file, its design built in",
+                       description="Write NAME.h, NAME.c (C99, libm), NAME.py (NumPy), NAME_selftest.c, "
+                       "CMakeLists.txt (target NAME::NAME) and NAME.pc.in for the chain into --out.")
+    p.add_argument("file", help="a chain TOML file")
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="output folder: new, empty, or written by an earlier apair codegen")
+    p.add_argument("--prefix", metavar="NAME", help="name of the files and functions (default: from the file name)")
+    p.add_argument("--kernels", metavar="LIST",
+                   help="comma-separated subset of fk, fk_study, jacobian, mass_matrix, coriolis, gravity_torques, "
+                   "bias, inverse_dynamics, forward_dynamics, energy (default: all)")
+    p.set_defaults(func=_cmd_codegen)
     p = sub.add_parser("kernels", help="list the generated kernels with their operation counts")
     p.set_defaults(func=_cmd_kernels)
     p = sub.add_parser("demo", help="print the derived A-pair law and, given a chain file, one pose")

@@ -55,6 +55,14 @@ def set_backend(name: str | None) -> None:
         raise ValueError(f"backend: 'c' requested but {_native()[1]}")
     _state["backend"] = name
     _state["resolved"] = None
+    _enable_fast_paths(False)  # until the next kernel call resolves the backend again
+
+
+def _enable_fast_paths(flag: bool) -> None:
+    """Whether the chains' native fast paths (native_chain) may evaluate: only with the C backend."""
+    native = _native()[0]
+    if native is not None:
+        native.enable(flag)
 
 
 def backend() -> str:
@@ -63,6 +71,7 @@ def backend() -> str:
     resolved = _state["resolved"]
     if resolved is None:
         resolved = _state["resolved"] = _resolve_backend()
+        _enable_fast_paths(resolved == "c")
     return resolved
 
 
@@ -150,3 +159,33 @@ def call(name: str, *inputs) -> list[np.ndarray]:
     inputs = [_float64(name, a["name"], x) for x, a in zip(inputs, spec)]
     out = _numpy_function(name)(*inputs)
     return list(out) if isinstance(out, tuple) else [out]
+
+
+class _NoFastPath:
+    """The stand-in for a chain's native fast path where the C kernels are not installed."""
+
+    @staticmethod
+    def call(method, *inputs):
+        return None
+
+
+def native_chain(n: int, methods, laws, limits, design: dict, keep=None, table=None):
+    """A chain's native fast path (apair._native.Chain): `methods` = [(kernel name, strict)],
+    each a registry kernel, or with `table` = (address, names) an entry of a loaded registry of
+    specialised kernels (AChain.specialise); `laws` = per joint (law kernel name, params), or []
+    when the kernels take q itself; `limits` = per joint |θ| range (inf: none); `design` = the
+    arrays the kernels take by name; `keep`: what must outlive the kernels. Its call(method, q,
+    ...) returns None whenever the caller must validate first (or the backend is NumPy)."""
+    native = _native()[0]
+    if native is None:
+        return _NoFastPath()
+    if table is None:
+        address = lambda name: native.kernel_address(_c_index(native, name))
+    else:
+        base, names = table
+        index = {name: i for i, name in enumerate(names)}
+        address = lambda name: base + index[name] * native.KERNEL_SIZE if name in index else None
+    generic = lambda name: native.kernel_address(_c_index(native, name))
+    return native.Chain(n, [(address(name), bool(strict)) for name, strict in methods],
+                        [(generic(name), tuple(float(x) for x in params)) for name, params in laws],
+                        [float(x) for x in limits], dict(design), keep)

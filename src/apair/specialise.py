@@ -1,0 +1,304 @@
+"""Code for one chain with its design built in: `apair codegen CHAIN.toml` writes it (C, NumPy,
+CMake, pkg-config, a self-test), `AChain.specialise()` compiles and loads it.
+
+The kernels come from derivations/specialised.py (the generic chain kernels with the design folded
+in), lowered and printed by the one emitter (codegen/emitter.py). Both ship inside the installed
+package as apair.derivations and apair.codegen. The self-test's reference values are computed here
+by the generic runtime, so the generated code is checked against an independent evaluation.
+"""
+from __future__ import annotations
+
+import hashlib
+import keyword
+import re
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from .chain import AChain
+
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+_C_KEYWORDS = frozenset(
+    "auto break case char const continue default do double else enum extern float for goto if inline int long "
+    "register restrict return short signed sizeof static struct switch typedef union unsigned void volatile while "
+    "bool true false class namespace new delete template this operator private public protected".split())
+SELFTEST_STATES = 4
+
+
+def _toolkit():
+    from . import codegen, derivations  # noqa: F401  (the installed copies of the source tree's packages)
+    from .codegen import emitter
+    from .derivations import specialised
+
+    return specialised, emitter
+
+
+def design_of(chain):
+    """The chain's constants as derivations.specialised.Design (plain numbers)."""
+    specialised, _ = _toolkit()
+    return specialised.Design(
+        kinds=tuple(p.kind for p in chain.pairs),
+        law=tuple(tuple(float(x) for x in p.law_kernel[1]) for p in chain.pairs),
+        dh=tuple(tuple(float(x) for x in row) for row in chain._dh),
+        links=tuple(tuple(float(x) for x in row) for row in chain._links),
+        legs=tuple(tuple(float(x) for x in row) for row in chain._legs),
+        gravity=tuple(float(x) for x in chain.gravity))
+
+
+@lru_cache(maxsize=None)
+def toolkit_digest() -> str:
+    """SHA-256 of what turns a design into code: the derivations, the code generator with its
+    templates, and the sympy version (its printing and evaluation shape the output)."""
+    import sympy
+
+    root = Path(__file__).resolve().parent
+    h = hashlib.sha256(f"sympy {sympy.__version__}\0".encode())
+    for folder in ("derivations", "codegen", "codegen/templates"):
+        for path in sorted((root / folder).glob("*")):
+            if path.is_file() and path.suffix in (".py", ".j2"):
+                h.update(f"{folder}/{path.name}\0".encode() + path.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
+def content_hash(chain, kernels) -> str:
+    """16 hex digits identifying the generated code: the design, the kernels chosen, the toolkit."""
+    h = hashlib.sha256(design_of(chain).canonical().encode())
+    h.update((",".join(kernels) + "\0" + toolkit_digest()).encode())
+    return h.hexdigest()[:16]
+
+
+def check_prefix(name: str) -> str:
+    """A prefix usable as C identifier stem and Python module name, or a ValueError."""
+    if not isinstance(name, str) or not _IDENT.match(name) or len(name) > 48:
+        raise ValueError(f"prefix: expected a C identifier (letters, digits, _; not starting with a digit; at most "
+                         f"48 characters), got {name!r}")
+    if name in _C_KEYWORDS or keyword.iskeyword(name) or name.startswith("apair"):
+        raise ValueError(f"prefix: {name!r} is a C, C++ or Python keyword or apair's own prefix")
+    return name
+
+
+def prefix_from(path) -> str:
+    """The default prefix of a chain file: its name without .toml, made an identifier."""
+    stem = re.sub(r"[^A-Za-z0-9_]", "_", Path(path).stem) or "chain"
+    if stem[0].isdigit():
+        stem = "chain_" + stem
+    return check_prefix(stem[:48])
+
+
+def check_kernels(kernels) -> tuple[str, ...]:
+    specialised, _ = _toolkit()
+    if kernels is None:
+        return tuple(specialised.KERNELS)
+    kernels = tuple(kernels)
+    unknown = [k for k in kernels if k not in specialised.KERNELS]
+    if unknown or not kernels:
+        raise ValueError(f"kernels: expected names from {', '.join(specialised.KERNELS)}, got {', '.join(kernels) or 'none'}")
+    return tuple(k for k in specialised.KERNELS if k in kernels)
+
+
+def lowered(chain, kernels) -> list:
+    """The chain's specialised kernels, derived and lowered (CSE, printed)."""
+    specialised, emitter = _toolkit()
+    return [emitter.lower(s) for s in specialised.chain_specs(design_of(chain), kernels)]
+
+
+def _states(chain, count: int, seed: int) -> dict[str, np.ndarray]:
+    """The self-test's states: q = 0, then random joint values well inside the limits; random qd,
+    qdd, tau."""
+    rng = np.random.default_rng(seed)
+    lim = chain.limits
+    mid, half = lim.mean(axis=1), (lim[:, 1] - lim[:, 0]) / 2
+    q = mid + 0.9 * half * rng.uniform(-1, 1, (count, chain.n))
+    q[0] = np.clip(0.0, lim[:, 0] + 0.05 * half, lim[:, 1] - 0.05 * half)
+    return {"q": q, "qd": rng.normal(size=(count, chain.n)), "qdd": rng.normal(size=(count, chain.n)),
+            "tau": rng.normal(size=(count, chain.n))}
+
+
+def references(chain, kernels: list, count: int = SELFTEST_STATES, seed: int = 0) -> list[dict]:
+    """Inputs and generic-runtime outputs of each kernel on the self-test's states; a kernel whose
+    reference cannot be computed (forward dynamics of a chain without inertia) is left out."""
+    states = _states(chain, count, seed)
+    methods = {"coriolis": "coriolis_matrix"}
+    tests = []
+    for k in kernels:
+        ins = [states[a.name] for a in k.spec.inputs]
+        try:
+            want = getattr(chain, methods.get(k.name, k.name))(*ins)
+        except ValueError:
+            continue
+        tests.append({"name": k.name,
+                      "inputs": [(a, [f"{x:.17g}" for x in v.ravel()]) for a, v in zip(k.spec.inputs, ins)],
+                      "outputs": [(k.spec.outputs[0], [f"{x:.17g}" for x in np.asarray(want).ravel()])]})
+    return tests
+
+
+def _describe(chain) -> tuple[str, str]:
+    joints = ", ".join(f"{i + 1} {p.kind}" for i, p in enumerate(chain.pairs))
+    ranges = "; ".join(f"|q_{i + 1}| <= {p.theta_limit!r} (mod 2 pi)" for i, p in enumerate(chain.pairs)
+                       if p.theta_limit is not None)
+    return joints, ranges
+
+
+def render(chain, name: str, origin: str, kernels=None, title: str | None = None, code=None) -> dict[str, str]:
+    """{file name: text} of the chain's code (see codegen.emitter.Emitter.render_chain); `code`:
+    the lowered kernels if already at hand."""
+    _, emitter = _toolkit()
+    name = check_prefix(name)
+    kernels = check_kernels(kernels)
+    code = code or lowered(chain, kernels)
+    tests = references(chain, code)
+    by_name = {k.name: k for k in code}
+    joints, ranges = _describe(chain)
+    # the title goes into C comments, CMake and pkg-config strings: plain characters only
+    title = " ".join(re.sub(r"[^\w .,:()+-]", " ", title or f"{chain.n}-joint chain").split())[:80]
+    origin = re.sub(r"[^\w .,:+/-]", "_", origin)[:120]
+    meta = {"title": title, "origin": origin, "joints": joints, "ranges": ranges,
+            "n": chain.n, "hash": content_hash(chain, kernels)}
+    return emitter.Emitter().render_chain(code, name, meta, [dict(t, kernel=by_name[t["name"]]) for t in tests])
+
+
+def write_code(chain, out, name: str, origin: str, kernels=None, title: str | None = None) -> list[str]:
+    """Write the chain's code into the folder `out` (created if need be; a non-empty folder is
+    refused unless an earlier run of this wrote it). Returns the files changed."""
+    _, emitter = _toolkit()
+    files = render(chain, name, origin, kernels, title)
+    try:
+        return emitter.write(files, Path(out))
+    except emitter.OutputError as exc:
+        raise ValueError(str(exc)) from None
+
+
+# ------------------------------------------------------------------------------------ AChain.specialise
+_warned = set()
+
+
+def cache_root() -> Path:
+    """Where compiled specialised chains are kept: $APAIR_CACHE, else $XDG_CACHE_HOME/apair, else
+    ~/.cache/apair."""
+    import os
+
+    if os.environ.get("APAIR_CACHE"):
+        return Path(os.environ["APAIR_CACHE"])
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "apair"
+
+
+def _compiler() -> str | None:
+    import os
+    import shutil
+
+    cc = os.environ.get("CC") or "cc"
+    return shutil.which(cc) or shutil.which("gcc")
+
+
+def _warn_once(key: str, message: str) -> None:
+    import warnings
+
+    if key not in _warned:
+        _warned.add(key)
+        warnings.warn(message, RuntimeWarning, stacklevel=4)
+
+
+def build(chain, kernels=None) -> tuple[Path, str, tuple[str, ...]] | None:
+    """The chain's specialised kernels compiled into a shared library in the cache (built on
+    first use; the folder is named by the content hash, so a build of other code is never
+    taken). Returns (library, symbol prefix, kernel names), or None without a C compiler."""
+    import os
+    import subprocess
+    import tempfile
+
+    from . import kernels as _kernels
+
+    kernels = check_kernels(kernels)
+    digest = content_hash(chain, kernels)
+    name = f"spec_{digest}"
+    folder = cache_root() / "specialised" / digest
+    library = folder / f"lib{name}.so"
+    if library.is_file():
+        return library, name, kernels
+    cc = _compiler()
+    if cc is None:
+        _warn_once("cc", "apair: AChain.specialise() found no C compiler (set CC, or install gcc); the chain "
+                         "uses the generic kernels")
+        return None
+    _, emitter = _toolkit()
+    code = lowered(chain, kernels)
+    files = render(chain, name, "AChain.specialise()", kernels, code=code)
+    files[f"{name}_registry.c"] = emitter.Emitter().render_chain_registry(code, name, digest)
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    include = Path(_kernels.__file__).parent / "generated" / "c"
+    with tempfile.TemporaryDirectory(dir=folder.parent, prefix=f".{digest}-") as tmp:
+        work = Path(tmp) / digest
+        work.mkdir()
+        for rel, text in files.items():
+            (work / rel).write_text(text)
+        cmd = [cc, "-std=c99", "-O2", "-fno-math-errno", "-fPIC", "-shared", f"-I{include}", f"{name}.c",
+               f"{name}_registry.c", "-o", library.name, "-lm"]
+        res = subprocess.run(cmd, cwd=work, capture_output=True, text=True)
+        if res.returncode != 0:
+            raise RuntimeError(f"specialise: compiling the chain's kernels failed ({' '.join(cmd)}): "
+                               f"{' '.join(res.stderr.split())[:400]}")
+        try:
+            os.rename(work, folder)  # atomic: another process may have won the race, which is fine
+        except OSError:
+            if not library.is_file():
+                raise
+    return library, name, kernels
+
+
+def load(chain, kernels=None):
+    """The native fast path of the chain's specialised kernels (kernels.native_chain) and the
+    loaded library, or None (no compiler, or the C backend is not installed)."""
+    import ctypes
+
+    from . import chain as _chain
+    from . import kernels as _kernels
+
+    if not _kernels.c_available():
+        _warn_once("native", "apair: AChain.specialise() needs the compiled C kernels (apair._native); the "
+                             "chain uses the generic kernels")
+        return None
+    built = build(chain, kernels)
+    if built is None:
+        return None
+    library, name, names = built
+    lib = ctypes.CDLL(str(library))
+    count = ctypes.c_int.in_dll(lib, f"{name}_registry_count").value
+    if count != len(names):
+        raise RuntimeError(f"specialise: {library} holds {count} kernels, expected {len(names)}: remove it")
+    base = ctypes.addressof(ctypes.c_char.in_dll(lib, f"{name}_registry"))
+    families = {f: k for k, f in _toolkit()[0].KERNELS.items()}
+    fast = _kernels.native_chain(
+        chain.n, [(families.get(family, family), strict) for family, strict in _chain.METHODS], [],
+        [p.theta_limit if p.theta_limit is not None else float("inf") for p in chain.pairs], {}, keep=lib,
+        table=(base, names))
+    return fast
+
+
+class SpecialisedChain(AChain):
+    """An AChain whose kernel-backed methods (fk ... energy) run the chain's own specialised C
+    kernels (AChain.specialise); everything else is the AChain's. Where they cannot be had (no
+    C compiler), the generic kernels serve, as said once in a warning."""
+
+    def __init__(self, chain: AChain, kernels=None):
+        self.__dict__.update({k: v for k, v in chain.__dict__.items() if k != "_fast"})
+        self._kernels = check_kernels(kernels)
+        self.content_hash = content_hash(chain, self._kernels)
+        self._attach()
+
+    def _attach(self) -> None:
+        """The specialised fast path (building it on first use; the references of its self-test
+        come from the generic kernels, which serve until then)."""
+        self._fast = self._native_chain()
+        fast = load(self, self._kernels)
+        self.specialised = fast is not None
+        if fast is not None:
+            self._fast = fast
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._attach()
+
+    def __repr__(self) -> str:
+        return f"{super().__repr__()}.specialise()"
