@@ -8,9 +8,9 @@ DEPS_STAMP := $(VENV)/.deps-stamp
 CFLAGS_STRICT := -std=c99 -Wall -Wextra -Werror -pedantic -O2
 CHECK_DIR := build/check-generated
 
-.PHONY: all venv generate install varieties lib demo check test bench clean
+.PHONY: all venv generate install varieties lib examples demo check test bench clean
 
-all: generate install varieties lib demo
+all: generate install varieties lib examples demo
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -47,16 +47,25 @@ build/obj/%.o: generated/c/%.c generated/c/apair.h generated/c/apair_internal.h
 	@mkdir -p build/obj
 	gcc $(CFLAGS_STRICT) -fPIC -c $< -o $@
 
+# The example chain's own code (apair codegen), committed like generated/ and compared by make check.
+EXAMPLE_CODE := examples/codegen/chain4a
+EXAMPLE_CODEGEN = $(BIN)/apair codegen examples/4a_chain.toml --prefix chain4a --out
+examples: install
+	$(EXAMPLE_CODEGEN) $(EXAMPLE_CODE)
+
 demo: install
 	$(BIN)/apair demo examples/4a_chain.toml
 
 # Regenerate into a scratch folder and fail if it differs from the committed generated/.
 check: install
-	rm -rf $(CHECK_DIR)
+	rm -rf $(CHECK_DIR) $(CHECK_DIR)-example
 	PYTHONPATH=. $(PY) -m codegen --out $(CHECK_DIR)
 	PYTHONPATH=. $(PY) -m codegen.varieties --out $(CHECK_DIR)
 	diff -r -x __pycache__ generated $(CHECK_DIR) || \
 	  (echo "generated/ is out of date with the derivations: run make generate and commit" >&2; exit 1)
+	$(EXAMPLE_CODEGEN) $(CHECK_DIR)-example
+	diff -r $(EXAMPLE_CODE) $(CHECK_DIR)-example || \
+	  (echo "$(EXAMPLE_CODE) is out of date: run make examples and commit" >&2; exit 1)
 
 test: install lib check
 	$(PY) -m pytest -q

@@ -158,6 +158,69 @@ int main(int argc, char **argv)
 """
 
 
+SPECIALISED = "bench_spec"  # the prefix of the specialised code (apair codegen) timed here
+
+
+def specialised_program(n: int) -> str:
+    """C source timing the chain's specialised kernels (apair codegen): they take q (and qd, qdd
+    or tau) only, the design is built in."""
+    body, names = [], list(OPERATIONS)
+    for k, (op, (stem, extra, size)) in enumerate(OPERATIONS.items()):
+        args = ", ".join(["Q"] + [x.upper() for x in extra])
+        body.append(f"""
+        t0 = now_ns();
+        {SPECIALISED}_{op}_batch((size_t)COUNT, {args}, OUT_{op});
+        t = (now_ns() - t0) / COUNT;
+        if (round > 0 && t < best[{k}]) best[{k}] = t;""")
+    outs = "\n".join(f"static double *OUT_{op};" for op in names)
+    allocs = "\n    ".join(f"OUT_{op} = (double *)malloc(sizeof(double) * COUNT * {OPERATIONS[op][2](n)});"
+                          for op in names)
+    dumps = "\n    ".join(f"fwrite(OUT_{op}, sizeof(double), {CHECKED} * {OPERATIONS[op][2](n)}, f);" for op in names)
+    prints = " ".join(f'printf("%s\\"{op}\\": %.3f", "{"{" if k == 0 else ", "}", best[{k}]);'
+                      for k, op in enumerate(names))
+    return f"""#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "{SPECIALISED}.h"
+#include "bench_inputs.h"
+
+{outs}
+
+int main(int argc, char **argv)
+{{
+    double best[{len(names)}], t0, t;
+    int round, k;
+    FILE *f;
+    if (argc < 4 || read_inputs(argv[1])) return 2;
+    {allocs}
+    for (k = 0; k < {len(names)}; ++k) best[k] = 1e300;
+    for (round = 0; round <= atoi(argv[3]); ++round) {{{''.join(body)}
+    }}
+    f = fopen(argv[2], "wb");
+    {dumps}
+    fclose(f);
+    {prints}
+    printf("}}\\n");
+    return 0;
+}}
+"""
+
+
+def specialised_build(chain, workdir: Path, opt: str) -> Path:
+    """The timing program of the chain's specialised code (generated once per content hash)."""
+    from apair import specialise
+
+    kernels = tuple(OPERATIONS)
+    code = workdir / f"specialised_{specialise.content_hash(chain, kernels)}"
+    if not (code / f"{SPECIALISED}.c").exists():
+        specialise.write_code(chain, code, SPECIALISED, "the bench chain", kernels)
+    exe = workdir / f"specialised{chain.n}{opt}"
+    source = specialised_program(chain.n)
+    return cached(exe, [source, (code / f"{SPECIALISED}.c").read_text(), opt],
+                  lambda: compile_c(source, exe, [opt, f"-I{code}", f"-I{PEERS}"], [str(code / f"{SPECIALISED}.c"), "-lm"]))
+
+
 def pinned(cmd: list[str]) -> list[str]:
     """cmd run on one core (the last one) where taskset exists."""
     taskset = shutil.which("taskset")
@@ -360,7 +423,8 @@ def compare(chain, states: States, workdir: Path, opts=("-O2", "-O3"), rounds: i
             log=print) -> dict:
     """Every tool on `chain` and `states` at each optimisation level: agreement with apair first,
     then `rounds` round-robin rounds (each program evaluates every operation over all poses once
-    per round); the minimum ns per evaluation over the rounds."""
+    per round); the minimum ns per evaluation over the rounds. apair runs twice: its generic
+    kernels ("apair") and the chain's own specialised code ("apair_specialised")."""
     workdir.mkdir(parents=True, exist_ok=True)
     n = chain.n
     inputs = workdir / f"inputs{n}.bin"
@@ -378,6 +442,7 @@ def compare(chain, states: States, workdir: Path, opts=("-O2", "-O3"), rounds: i
     for opt in opts:
         log(f"  building at {opt} ...")
         tools[f"apair {opt}"] = apair_build(chain, workdir, opt)
+        tools[f"apair_specialised {opt}"] = specialised_build(chain, workdir, opt)
         if peers:
             try:
                 tools[f"pinocchio {opt}"] = pinocchio_build(workdir, opt)

@@ -182,6 +182,7 @@ def bench_chain(n: int, rng, batch: int, single: int, slow: int, repeats: int, p
     design = {"dh": chain._dh, "links": chain._links, "legs": chain._legs, "gravity": chain.gravity}
     per_pose = {"law": chain._law(q), "qd": qd, "qdd": qdd, "tau": tau}
     pin_f, pin_check = pin_functions(chain) if pin_ok else ({}, {})
+    specialised = chain.specialise()  # compiled once, then found in the cache
     out = {}
     for op in OPS:
         row = {}
@@ -198,6 +199,9 @@ def bench_chain(n: int, rng, batch: int, single: int, slow: int, repeats: int, p
                     "forward_dynamics": lambda k: (q[k], qd[k], tau[k])}[op]
         method = getattr(chain, op)
         row["c_single_api"] = per_item(loop(method, [api_args(k) for k in range(single)]), single, repeats)
+        if specialised.specialised:
+            row["specialised_single_api"] = per_item(loop(getattr(specialised, op), [api_args(k) for k in range(single)]),
+                                                     single, repeats)
         row["numpy_batched"] = per_item(lambda: NUMPY_KERNELS[name](*inputs), batch, repeats)
         spec = sp_specs[name]
         flat = flat_inputs(spec, inputs)
@@ -263,6 +267,30 @@ def time_generate() -> float:
         return time.perf_counter() - t0
 
 
+def time_codegen(chain) -> float:
+    """Wall time of `apair codegen` (every kernel) for a 6-joint chain in a fresh process: the chain
+    is written as a chain file first."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "arm6.toml"
+        lines = []
+        for p, a, al, c, ph, link in zip(chain.pairs, chain.a, chain.alpha, chain.offset, chain.theta_offset,
+                                         chain.links):
+            lines += ["[[joint]]", f'pair = "{p.kind}"']
+            if p.kind != "revolute":
+                lines += [f"base_radius = {p.base_radius!r}", f"platform_radius = {p.platform_radius!r}",
+                          f"leg_mass = {p.leg_mass!r}"]
+            I = link.inertia
+            lines += [f"a = {a!r}", f"alpha = {al!r}", f"offset = {c!r}", f"theta_offset = {ph!r}",
+                      f"mass = {link.mass!r}", f"com = {link.com.tolist()!r}",
+                      f"inertia = {[I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]!r}", ""]
+        lines.append(f"gravity = {chain.gravity.tolist()!r}")
+        path.write_text("\n".join(lines) + "\n")
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "apair", "codegen", str(path), "--out", str(Path(tmp) / "out")],
+                       check=True, capture_output=True)
+        return time.perf_counter() - t0
+
+
 def random_achain(n: int, rng) -> apair.AChain:
     """random_chain's kind of design with sinusoidal A-pairs whose legs have mass."""
     r = random_chain(n, rng)
@@ -278,11 +306,14 @@ def native_section(rng, quick: bool) -> dict:
     count, rounds = (2000, 3) if quick else (10_000, 7)
     work = ROOT / "build" / "bench"
     out = {}
-    for label, chain in (("R-chain", random_chain(6, rng)), ("A-chain", random_achain(6, rng))):
+    example = apair.load(ROOT / "examples" / "4a_chain.toml")
+    for label, chain in (("R-chain", random_chain(6, rng)), ("A-chain", random_achain(6, rng)),
+                         ("examples/4a_chain.toml", example)):
+        n = chain.n
         lim = np.array([min(p.theta_limit or np.pi, np.pi) * 0.95 for p in chain.pairs])
-        states = native.States(rng.uniform(-lim, lim, (count, 6)), rng.normal(size=(count, 6)),
-                               rng.normal(size=(count, 6)), rng.normal(size=(count, 6)))
-        print(f"compiled comparison, {label} (n = 6, {count} states):", file=sys.stderr, flush=True)
+        states = native.States(rng.uniform(-lim, lim, (count, n)), rng.normal(size=(count, n)),
+                               rng.normal(size=(count, n)), rng.normal(size=(count, n)))
+        print(f"compiled comparison, {label} (n = {n}, {count} states):", file=sys.stderr, flush=True)
         out[label] = native.compare(chain, states, work / label, rounds=rounds, peers=label == "R-chain",
                                     log=lambda m: print(m, file=sys.stderr, flush=True))
     manifest = kernels.manifest()["kernels"]
@@ -292,9 +323,23 @@ def native_section(rng, quick: bool) -> dict:
 
 def native_targets(native_res: dict) -> list[dict]:
     """Issue 15's targets: per opt level, M, ID, FD <= 0.7 x Pinocchio C++ and <= 1.0 x CasADi with
-    the design as inputs; fk and Jacobian <= 0.8 x Pinocchio and <= 1.3 x their trigonometric calls."""
+    the design as inputs; fk and Jacobian <= 0.8 x Pinocchio and <= 1.3 x their trigonometric calls.
+    Issue 16's: the specialised code <= 0.8 x CasADi with the design baked in (R-chain) and
+    <= 0.6 x apair's generic kernels on examples/4a_chain.toml, for all five operations."""
     tools = native_res["R-chain"]["tools"]
     out = []
+    from bench.native import OPERATIONS
+
+    for opt in ("-O2", "-O3"):
+        for label, peer, bound in (("R-chain", "casadi_baked", 0.8), ("examples/4a_chain.toml", "apair", 0.6)):
+            spec = native_res[label]["tools"].get(f"apair_specialised {opt}")
+            other = native_res[label]["tools"].get(f"{peer} {opt}")
+            if spec is None or other is None:
+                continue
+            for op in OPERATIONS:
+                r = spec["ns"][op] / other["ns"][op]
+                out.append({"target": f"{op} {opt}, {label}: specialised <= {bound} x {peer}", "measured": r,
+                            "met": r <= bound})
     for opt in ("-O2", "-O3"):
         me = tools.get(f"apair {opt}")
         if me is None:
@@ -342,9 +387,10 @@ def print_native(native_res: dict) -> None:
         print("CasADi SX operations: " + ", ".join(f"{k} {v}" for k, v in r["casadi_ops"].items()))
     for tool, why in r["skipped"].items():
         print(f"skipped {tool}: {why}")
-    a = native_res["A-chain"]
-    print("A-chain (sinusoidal pairs with leg mass, n = 6), apair only: " + "; ".join(
-        f"{name}: " + ", ".join(f"{op} {t:.0f}" for op, t in a['tools'][name]['ns'].items()) for name in a["tools"]))
+    for label in ("A-chain", "examples/4a_chain.toml"):
+        a = native_res[label]
+        print(f"{label} (n = {a['n']}, sinusoidal pairs with leg mass), apair only, ns: " + "; ".join(
+            f"{name}: " + ", ".join(f"{op} {t:.0f}" for op, t in a['tools'][name]['ns'].items()) for name in a["tools"]))
 
 
 def random_4a(rng) -> apair.AChain:
@@ -387,6 +433,16 @@ def targets(results: dict) -> list[dict]:
             r = row["peer_over_c_batched"]["pinocchio_per_call"]
             out.append({"target": f"batched C >= 2x faster than Pinocchio per call, {op}, n = 6", "measured": r,
                         "met": r >= 2.0})
+    for op in ("fk", "jacobian", "mass_matrix", "inverse_dynamics", "forward_dynamics"):
+        row = six.get(op, {})
+        for mine, what in (("c_single_api", "generic"), ("specialised_single_api", "specialised")):
+            if "pinocchio_per_call" in row and mine in row:
+                r = row[mine]["median_ns"] / row["pinocchio_per_call"]["median_ns"]
+                out.append({"target": f"Python single call, {what} chain.{op}, n = 6: <= 1.0 x Pinocchio's Python call",
+                            "measured": r, "met": r <= 1.0})
+    if results.get("codegen_6_s") is not None:
+        g = results["codegen_6_s"]
+        out.append({"target": "apair codegen of a 6-joint chain, every kernel, < 60 s", "measured": g, "met": g < 60})
     worst = max(row["single_call_overhead_ns"] for rows in results["kernels"].values() for row in rows.values())
     out.append({"target": "single-call Python overhead (apair.kernels.call, best of repeats) < 2 µs, worst kernel",
                 "measured": worst / 1e3, "met": worst < 2000})
@@ -444,10 +500,12 @@ def main(argv=None) -> int:
              "examples/4a_chain.toml": ([apair.load(ROOT / "examples/4a_chain.toml")], 20 if args.quick else 200)}
     results["ik"] = {name: time_ik(chains, k, rng) for name, (chains, k) in cases.items()}
     results["make_generate_s"] = None if args.no_generate else time_generate()
+    results["codegen_6_s"] = time_codegen(random_achain(6, rng))
     results["targets"] = targets(results)
 
     print("\nper evaluation, median over repeats (ratio = peer time / batched C time):")
     cols = [("c_batched", "C batched"), ("c_single", "C 1 call"), ("c_single_api", "API 1 call"),
+            ("specialised_single_api", "specialised 1"),
             ("numpy_batched", "NumPy batch"), ("lambdify_loop", "lambdify loop"), ("symengine_batched", "symengine"),
             ("pinocchio_per_call", "Pinocchio")]
     print(f"{'kernel':24s}{'ops':>7s}" + "".join(f"{c[1]:>15s}" for c in cols))

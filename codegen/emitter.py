@@ -288,6 +288,8 @@ class Emitter:
         lowered = {stem: ks for stem, ks in lowered.items() if ks}  # skip set-only derivations
         all_kernels = [k for ks in lowered.values() for k in ks]
         fingerprints = {k.name: k.fingerprint for k in all_kernels}
+        by_name = {k.name: k for k in all_kernels}
+        inv_sizes = {k.name: _invariant_size(k, by_name) for k in all_kernels if k.hoisted or k.calls}
 
         header_t, header_src = self._template("apair.h.j2")
         src_t, src_src = self._template("kernels.c.j2")
@@ -295,10 +297,9 @@ class Emitter:
         sources = sorted({k.spec.source for k in all_kernels})
         registry_t, registry_src = self._template("registry.c.j2")
         files["c/apair_registry.c"] = registry_t.render(
-            kernels=sorted(all_kernels, key=lambda k: k.name), prefix=PREFIX, sources=sources,
+            kernels=sorted(all_kernels, key=lambda k: k.name), prefix=PREFIX, sources=sources, inv_sizes=inv_sizes,
             hash=content_hash([registry_src] + [fingerprints[k.name] for k in all_kernels]))
         # one C file per kernel: a program that links the library takes only the kernels it calls
-        by_name = {k.name: k for k in all_kernels}
         called = sorted({c.kernel for k in all_kernels for c in k.calls})
         for name in called:
             if by_name[name].hoisted is None:
@@ -311,13 +312,13 @@ class Emitter:
         for k in all_kernels:
             c_hash = content_hash([src_src, fingerprints[k.name]] + [fingerprints[c.kernel] for c in k.calls])
             files[f"c/{k.name}.c"] = src_t.render(kernels=[k], source=k.spec.source, hash=c_hash, prefix=PREFIX,
-                                                  by_name=by_name, called=called)
+                                                  by_name=by_name, called=called, inv_sizes=inv_sizes)
         c_sources = sorted(["apair_registry.c"] + [f"{k.name}.c" for k in all_kernels])
         # the header's hash covers every C source the binding compiles (so their templates too)
         header_hash = content_hash([header_src, VERSION] + [fingerprints[k.name] for k in all_kernels]
                                    + [files[f"c/{c}"] for c in c_sources] + [files["c/apair_internal.h"]])
         files["c/apair.h"] = header_t.render(kernels=all_kernels, hash=header_hash, sources=sources, prefix=PREFIX,
-                                             version=VERSION)
+                                             version=VERSION, inv_sizes=inv_sizes)
         for name in ("CMakeLists.txt", "apair.pc.in"):
             t, src = self._template(f"{name}.j2")
             files[f"c/{name}"] = t.render(sources=sources, c_sources=c_sources, version=VERSION,
@@ -351,15 +352,17 @@ class Emitter:
         return files
 
 
-    def render_chain(self, kernels: list[Lowered], name: str, meta: dict, tests: list[dict]) -> dict[str, str]:
+    def render_chain(self, kernels: list[Lowered], parts: dict[str, Lowered], name: str, meta: dict,
+                     tests: list[dict]) -> dict[str, str]:
         """The code of one chain with its design built in (derivations/specialised.py): name.h,
         name.c, name.py, name_selftest.c, CMakeLists.txt, name.pc.in and manifest.json;
-        `meta`: title, origin (the chain file), joints, ranges, n, hash; `tests`: per kernel checked
-        {kernel (Lowered), inputs: [(Arg, values)], outputs: [(Arg, values)]}, values as C literals."""
-        for k in kernels:
-            if k.calls or k.hoisted:
-                raise ValueError(f"{k.name}: a specialised kernel has no calls and no design inputs")
-        ctx = dict(meta, name=name, kernels=kernels, version=VERSION, guard=f"{name.upper()}_H")
+        `parts`: the kernels that `kernels` call, by name; `meta`: title, origin (the chain file),
+        joints, ranges, n, hash; `tests`: per kernel checked {kernel (Lowered), inputs:
+        [(Arg, values)], outputs: [(Arg, values)]}, values as C literals."""
+        for k in kernels + list(parts.values()):
+            if k.hoisted or any(c.kernel not in parts for c in k.calls):
+                raise ValueError(f"{k.name}: a specialised kernel has no design inputs, and its parts are given")
+        ctx = dict(meta, name=name, kernels=kernels, parts=parts, version=VERSION, guard=f"{name.upper()}_H")
         files = {}
         for template, out in (("chain.h.j2", f"{name}.h"), ("chain.c.j2", f"{name}.c"),
                               ("chain_CMakeLists.txt.j2", "CMakeLists.txt"), ("chain.pc.in.j2", f"{name}.pc.in")):
@@ -367,7 +370,7 @@ class Emitter:
         count = len(tests[0]["inputs"][0][1]) // tests[0]["inputs"][0][0].size if tests else 0
         files[f"{name}_selftest.c"] = self._template("chain_selftest.c.j2")[0].render(**ctx, count=count, tests=tests)
         files[f"{name}.py"] = self._template("kernels.py.j2")[0].render(
-            kernels=kernels, source=meta["origin"], hash=meta["hash"],
+            kernels=list(parts.values()) + kernels, source=meta["origin"], hash=meta["hash"],
             constants=[("N", meta["n"]), ("CONTENT_HASH", repr(meta["hash"]))])
         manifest = {"content_hash": meta["hash"], "prefix": name, "n": meta["n"], "origin": meta["origin"],
                     "kernels": {k.name: {"inputs": [{"name": a.name, "shape": list(a.shape)} for a in k.spec.inputs],
@@ -380,6 +383,12 @@ class Emitter:
     def render_chain_registry(self, kernels: list[Lowered], name: str, hash: str) -> str:
         """The registry of a specialised chain's kernels in apair.h's form (for the runtime)."""
         return self._template("chain_registry.c.j2")[0].render(kernels=kernels, name=name, hash=hash)
+
+
+def _invariant_size(k: Lowered, by_name: dict) -> int:
+    """Doubles of a kernel's split form: its own invariants after those of the kernels it calls."""
+    own = len(k.hoisted.stored) if k.hoisted else 0
+    return own + sum(len(by_name[c.kernel].hoisted.stored) for c in k.calls)
 
 
 def _ops_per_item(k: Lowered, by_name: dict) -> int:

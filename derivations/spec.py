@@ -38,12 +38,19 @@ class Arg:
 class Call:
     """Another kernel evaluated inside this one, so that its code exists once: `kernel` is the
     callee's spec (one output), `args` names, for each of its inputs, the caller's input passed
-    (same shape) or None for zeros, and `results` are the caller's symbols for the callee's
-    output, row-major."""
+    (same shape), "r<k>" for the output of the caller's k-th call (an earlier one, same size), or
+    None for zeros, and `results` are the caller's symbols for the callee's output, row-major."""
 
     kernel: "KernelSpec"
     args: tuple[str | None, ...]
     results: tuple[sp.Symbol, ...]
+
+
+def _result_index(arg) -> int | None:
+    """k for a Call argument "r<k>" (the output of the caller's k-th call), else None."""
+    if isinstance(arg, str) and arg[:1] == "r" and arg[1:].isdigit():
+        return int(arg[1:])
+    return None
 
 
 @dataclass
@@ -68,7 +75,7 @@ class KernelSpec:
                 raise ValueError(f"{self.name}: output {a.name} has {len(a.exprs)} exprs for shape {a.shape}")
         known = {s for a in self.inputs for s in a.symbols}
         mine = {a.name: a for a in self.inputs}
-        for c in self.calls:
+        for k, c in enumerate(self.calls):
             callee = c.kernel
             if len(callee.outputs) != 1 or len(c.results) != callee.outputs[0].size or c.kernel.calls:
                 raise ValueError(f"{self.name}: a call of {callee.name} needs one result symbol per output entry "
@@ -76,7 +83,11 @@ class KernelSpec:
             if len(c.args) != len(callee.inputs):
                 raise ValueError(f"{self.name}: {callee.name} takes {len(callee.inputs)} inputs")
             for name, a in zip(c.args, callee.inputs):
-                if name is not None and (name not in mine or tuple(mine[name].shape) != tuple(a.shape)):
+                earlier = _result_index(name)
+                if earlier is not None:
+                    if earlier >= k or self.calls[earlier].kernel.outputs[0].size != a.size:
+                        raise ValueError(f"{self.name}: {callee.name}'s input {a.name} cannot be {name}")
+                elif name is not None and (name not in mine or tuple(mine[name].shape) != tuple(a.shape)):
                     raise ValueError(f"{self.name}: {callee.name}'s input {a.name} {a.shape} cannot be {name}")
             known |= set(c.results)
         for sym, expr in self.steps:
@@ -102,7 +113,10 @@ class KernelSpec:
         for k, c in enumerate(self.calls):
             sub = {}
             for name, a in zip(c.args, c.kernel.inputs):
-                for s, t in zip(a.symbols, mine[name].symbols if name is not None else [0] * a.size):
+                earlier = _result_index(name)
+                given = (self.calls[earlier].results if earlier is not None else
+                         mine[name].symbols if name is not None else [0] * a.size)
+                for s, t in zip(a.symbols, given):
                     sub[s] = sp.S(t)
             for sym, e in c.kernel.steps:
                 new = sp.Symbol(f"c{k}_{sym.name}", real=True)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from . import apair_pair, chain_dynamics, chain_kinematics
-from .spec import Arg, KernelSpec
+from .spec import Arg, Call, KernelSpec
 
 SOURCE = "derivations/specialised.py"
 DIGITS = 40  # precision of the constants folded at generation time
@@ -128,11 +128,13 @@ def joint_values(n: int) -> Arg:
     return Arg("q", (n,), "joint values theta_i [rad]", syms)
 
 
-def law_steps(design: Design, law_symbols, q: Arg) -> tuple[list, dict]:
-    """Each joint's law kernel with its constants substituted, its input θ → q_i: the steps and
-    the bindings of the chain kernels' law symbols (ch, sh, d, d', d'' per joint)."""
+def law_steps(design: Design, law_symbols, q: Arg) -> tuple[list, dict, dict]:
+    """Each joint's law kernel with its constants substituted, its input θ → q_i: the steps, the
+    bindings of the chain kernels' law symbols (ch, sh, d, d', d'' per joint), and for R-pairs
+    the double-angle forms C² − S², 2CS mapped to cos q_i, sin q_i (an R-pair needs no half
+    angle: one sincos of q_i, and three operations fewer)."""
     laws = {s.name: s for s in apair_pair.law_specs()}
-    steps, env = [], {}
+    steps, env, double = [], {}, {}
     for i, (kind, params) in enumerate(zip(design.kinds, design.law)):
         spec = laws[f"law_{kind}"]
         sub = {spec.inputs[0].symbols[0]: q.symbols[i]}
@@ -141,16 +143,23 @@ def law_steps(design: Design, law_symbols, q: Arg) -> tuple[list, dict]:
         steps += more
         for s, e in zip(law_symbols[5 * i:5 * i + 5], spec.outputs[0].exprs):
             env[s] = _floats(sp.S(e).xreplace(sub))
-    return steps, env
+        if kind == "revolute":
+            C, S = env[law_symbols[5 * i]], env[law_symbols[5 * i + 1]]
+            double[C**2 - S**2] = sp.cos(q.symbols[i])
+            double[2 * C * S] = sp.sin(q.symbols[i])
+    return steps, env, double
 
 
-def _fold(steps, env: dict, suffix: str = "") -> tuple[list, dict]:
+def _fold(steps, env: dict, suffix: str = "", rewrite=None) -> tuple[list, dict]:
     """The steps with env substituted: those that become a number or a name are substituted into
-    the later ones instead of kept; `suffix` renames the kept ones. Returns (steps, env)."""
+    the later ones instead of kept; `suffix` renames the kept ones; a step that becomes a key of
+    `rewrite` becomes its value. Returns (steps, env)."""
     env = dict(env)
     out = []
     for sym, e in steps:
         v = _floats(e.xreplace(env))
+        if rewrite:
+            v = rewrite.get(v, v)
         if _trivial(v):
             env[sym] = v
             continue
@@ -161,19 +170,51 @@ def _fold(steps, env: dict, suffix: str = "") -> tuple[list, dict]:
     return out, env
 
 
-def specialise(spec: KernelSpec, design: Design, name: str, doc: str) -> KernelSpec:
+STATE = ("qd", "qdd", "tau")
+
+
+def specialise(spec: KernelSpec, design: Design, name: str, doc: str, zeros=(), law_input: bool = False) -> KernelSpec:
     """`spec` (a generic chain kernel) for this design: inputs q and the spec's own qd, qdd or
-    tau; its calls inlined, the law kernels in front, the design folded in."""
-    flat = spec.flattened()
-    q = joint_values(design.n)
+    tau (those in `zeros` are zero and gone); the law kernels in front (or, with `law_input`,
+    the law values as the input `law`), the design folded in.
+
+    A kernel that calls two or more others (forward dynamics: the mass matrix and the bias) keeps
+    them as calls of its own specialised parts, after a first part that evaluates the laws once
+    for all of them, so that a batch runs each part over a block of items while its code is in
+    the instruction cache (one function of all of it ran 1.5-2.5x slower); any other kernel's
+    calls are inlined and folded with it."""
+    keep = len(spec.calls) >= 2
+    flat = spec if keep else spec.flattened()
     by_name = {a.name: a for a in flat.inputs}
-    steps, env = law_steps(design, by_name["law"].symbols, q)
+    law = by_name["law"]
+    q = joint_values(design.n)
+    if law_input:
+        head, steps, env, double = [law], [], {}, {}
+    else:
+        head = [q]
+        steps, env, double = law_steps(design, law.symbols, q)
     env.update(design_values(design, flat.inputs))
-    more, env = _fold(flat.steps, env)
+    env.update({s: sp.S(0) for z in zeros for s in by_name[z].symbols})
+    inputs = head + [a for a in flat.inputs if a.name in STATE and a.name not in zeros]
+    calls = []
+    if keep:
+        laws = KernelSpec(f"{name}_law", f"Part of {name}: the joints' law values at q.", SOURCE, [q],
+                          [Arg("law", law.shape, law.doc, exprs=tuple(env[s] for s in law.symbols))], steps)
+        steps = []
+        calls.append(Call(laws, ("q",), tuple(sp.Symbol(f"{s.name}_v", real=True) for s in law.symbols)))
+        for c in flat.calls:
+            passed = {a.name: arg for arg, a in zip(c.args, c.kernel.inputs)}
+            part_zeros = [a for a, arg in passed.items() if arg is None]
+            family = c.kernel.name.rstrip("0123456789")
+            part = specialise(c.kernel, design, f"{name}_{family}", f"Part of {name}: " + c.kernel.doc.replace(
+                f" of a {design.n}-joint chain", "") + "".join(f" With {z} = 0." for z in part_zeros),
+                zeros=part_zeros, law_input=True)
+            args = tuple("r0" if a.name == "law" else passed[a.name] for a in part.inputs)
+            calls.append(Call(part, args, c.results))
+    more, env = _fold(flat.steps, env, rewrite=double)
     outputs = [Arg(a.name, a.shape, a.doc, exprs=tuple(_floats(sp.S(e).xreplace(env)) for e in a.exprs))
                for a in flat.outputs]
-    inputs = [q] + [a for a in flat.inputs if a.name in ("qd", "qdd", "tau")]
-    return KernelSpec(name, doc, SOURCE, inputs, outputs, steps + more)
+    return KernelSpec(name, doc, SOURCE, inputs, outputs, steps + more, calls)
 
 
 def generic_specs(n: int, families) -> dict[str, KernelSpec]:

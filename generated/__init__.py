@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: a19cd4b352ab5a1c
+Content hash: d51cc9c33c7b2c11
 """

@@ -12,6 +12,20 @@ import apair
 from codegen.__main__ import DERIVATIONS
 
 
+@pytest.fixture(scope="session", autouse=True)
+def specialised_cache(tmp_path_factory):
+    """Compiled specialised chains (AChain.specialise) go to a fresh folder, not the user's cache."""
+    import os
+
+    old = os.environ.get("APAIR_CACHE")
+    os.environ["APAIR_CACHE"] = str(tmp_path_factory.mktemp("apair-cache"))
+    yield
+    if old is None:
+        os.environ.pop("APAIR_CACHE", None)
+    else:
+        os.environ["APAIR_CACHE"] = old
+
+
 @pytest.fixture(scope="session")
 def derivations():
     """{module name: (polynomial sets, kernel specs, facts)}, derived afresh once per session."""

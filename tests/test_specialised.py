@@ -4,6 +4,7 @@ chain agree with the generic kernels on random states of random and special chai
 from __future__ import annotations
 
 import importlib.util
+import re
 import shutil
 import subprocess
 import sys
@@ -157,7 +158,7 @@ def test_special_constants_fold_exactly():
     base = special_chain(rng, 3)
     off = apair.AChain(base.pairs, base.a, base.alpha + np.radians(1.0), base.offset, base.theta_offset,
                        links=base.links, gravity=base.gravity)
-    ops = lambda ch: {k.name: k.ops for k in specialise.lowered(ch, ("fk", "mass_matrix"))}
+    ops = lambda ch: {k.name: k.ops for k in specialise.lowered(ch, ("fk", "mass_matrix"))[0]}
     assert all(a < b for a, b in zip(ops(base).values(), ops(off).values()))
 
 
@@ -181,3 +182,153 @@ def test_cli_codegen_writes_refuses_and_explains(tmp_path, capsys):
                       (["--kernels", "fk,warp"], "kernels")):
         assert main(["codegen", str(ROOT / "examples" / "4a_chain.toml"), "--out", str(tmp_path / "x"), *bad]) == 2
         assert f"error: {what}" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------------ AChain.specialise, fast path
+@pytest.fixture(scope="module")
+def cache(tmp_path_factory):
+    import os
+
+    old = os.environ.get("APAIR_CACHE")
+    os.environ["APAIR_CACHE"] = str(tmp_path_factory.mktemp("cache"))
+    yield Path(os.environ["APAIR_CACHE"])
+    if old is None:
+        del os.environ["APAIR_CACHE"]
+    else:
+        os.environ["APAIR_CACHE"] = old
+
+
+METHODS = ["fk", "fk_study", "jacobian", "mass_matrix", "coriolis_matrix", "gravity_torques", "bias",
+           "inverse_dynamics", "forward_dynamics", "energy"]
+
+
+def method_args(method, q, qd, qdd, tau):
+    return {"coriolis_matrix": (q, qd), "bias": (q, qd), "energy": (q, qd), "inverse_dynamics": (q, qd, qdd),
+            "forward_dynamics": (q, qd, tau)}.get(method, (q,))
+
+
+@gcc
+def test_specialised_chain_equals_the_generic_one(cache):
+    """Single calls, batches, lists and broadcast inputs of the compiled specialised chains against
+    the generic kernels (NumPy backend: independent of both native paths)."""
+    rng = np.random.default_rng(11)
+    for name, chain in chains().items():
+        fast = chain.specialise()
+        assert fast.specialised and isinstance(fast, apair.AChain) and fast.n == chain.n
+        q, qd, qdd, tau = states(chain, 40, rng)
+        apair.set_backend("numpy")
+        try:
+            want = {m: getattr(chain, m)(*method_args(m, q, qd, qdd, tau)) for m in METHODS}
+        finally:
+            apair.set_backend(None)
+        for m in METHODS:
+            got = getattr(fast, m)(*method_args(m, q, qd, qdd, tau))
+            close(got, want[m])
+            single = getattr(fast, m)(*method_args(m, q[3], qd[3], qdd[3], tau[3]))
+            close(single[None], want[m][3:4])
+            listed = getattr(fast, m)(*(x.tolist() for x in method_args(m, q[3], qd[3], qdd[3], tau[3])))
+            close(listed[None], want[m][3:4])
+            generic = getattr(chain, m)(*method_args(m, q, qd, qdd, tau))  # the generic fast path
+            close(generic, want[m])
+        # one q for a batch of velocities broadcasts
+        close(fast.bias(q[0], qd[:5]), chain.bias(np.broadcast_to(q[0], (5, chain.n)), qd[:5]))
+
+
+@gcc
+def test_specialised_builds_are_cached_by_content(cache):
+    chain = chains()["mixed3"]
+    first = chain.specialise()
+    builds = sorted(p.name for p in (cache / "specialised").iterdir())
+    again = chain.specialise()
+    assert sorted(p.name for p in (cache / "specialised").iterdir()) == builds  # found again, not rebuilt
+    assert again.content_hash == first.content_hash
+    other = apair.AChain(chain.pairs, chain.a + 0.01, chain.alpha, chain.offset, chain.theta_offset,
+                         links=chain.links, gravity=chain.gravity).specialise()
+    assert other.content_hash != first.content_hash and (cache / "specialised" / other.content_hash).is_dir()
+    subset = chain.specialise(kernels=["fk"])
+    q = np.array([0.1, 0.2, 0.3])
+    close(subset.mass_matrix(q)[None], chain.mass_matrix(q)[None])  # the others stay generic
+    import pickle
+
+    back = pickle.loads(pickle.dumps(first))
+    assert back.specialised and np.array_equal(back.fk(q), first.fk(q))
+
+
+def test_missing_compiler_falls_back_once(cache, monkeypatch):
+    monkeypatch.setenv("APAIR_CACHE", str(cache / "empty"))
+    monkeypatch.setattr(specialise, "_compiler", lambda: None)
+    monkeypatch.setattr(specialise, "_warned", set())
+    chain = chains()["one"]
+    with pytest.warns(RuntimeWarning, match="no C compiler"):
+        fast = chain.specialise()
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        again = chain.specialise()
+    assert not fast.specialised and not again.specialised
+    q = np.array([0.4])
+    assert np.array_equal(fast.fk(q), chain.fk(q))
+
+
+@pytest.mark.parametrize("specialised", [False, True])
+def test_bad_inputs_are_refused_on_every_path(cache, specialised):
+    """Whatever the fast path is handed, a bad input ends in the ValueError that names it."""
+    chain = ranged_chain(np.random.default_rng(2))
+    if specialised:
+        if shutil.which("gcc") is None:
+            pytest.skip("gcc is required")
+        chain = chain.specialise()
+    n = chain.n
+    ok = np.zeros(n)
+    lim = chain.pairs[0].theta_limit
+    cases = [
+        ("q", lambda: chain.fk(np.array([np.nan] + [0.0] * (n - 1))), "NaN"),
+        ("q", lambda: chain.mass_matrix(np.full(n, np.inf)), "NaN or infinite"),
+        ("q", lambda: chain.jacobian(np.zeros(n + 1)), "shape"),
+        ("q", lambda: chain.fk(np.zeros(n, dtype=complex)), "real numbers"),
+        ("qd", lambda: chain.bias(ok, np.array([np.nan] * n)), "NaN"),
+        ("qdd", lambda: chain.inverse_dynamics(ok, ok, np.zeros((2, n + 1))), "shape"),
+        ("qd", lambda: chain.energy(np.zeros((3, n)), np.zeros((2, n))), "batch shape"),
+        ("q[..., 0]", lambda: chain.fk(np.array([lim + 0.1] + [0.0] * (n - 1))), "outside this pair's range"),
+        ("q", lambda: chain.mass_matrix(np.array([lim] + [0.0] * (n - 1))), "limit"),
+    ]
+    for name, fn, what in cases:
+        with pytest.raises(ValueError, match=rf"^{re.escape(name)}: .*{what}"):
+            fn()
+    # what the fast path takes as it is and what it hands over give the same numbers
+    q = np.array([0.3, -0.2, 1.0])
+    for variant in (q.astype(np.float32), q.astype(">f8"), np.stack([q, q], axis=1)[:, 0], q.tolist(), q.astype(int)):
+        np.testing.assert_array_equal(chain.fk(variant), chain.fk(np.asarray(variant, dtype=np.float64)))
+    # rounding past the range end is put on it (position level), the end itself refused for dynamics
+    np.testing.assert_allclose(chain.fk(np.array([np.nextafter(lim, 4.0), 0, 0])), chain.fk(np.array([lim, 0, 0])))
+
+
+def test_forward_dynamics_of_a_massless_chain_is_refused(cache):
+    chain = apair.AChain([apair.APair.revolute()] * 2, [0.3, 0.2], [0.0, 0.0])
+    with pytest.raises(ValueError, match="^links: the mass matrix is not positive definite"):
+        chain.forward_dynamics(np.zeros(2), np.zeros(2), np.zeros(2))
+
+
+def test_numpy_backend_turns_the_fast_path_off():
+    chain = chains()["mixed3"]
+    q = np.array([0.1, 0.2, 0.3])
+    c = chain.fk(q)
+    apair.set_backend("numpy")
+    try:
+        assert chain._fast.call(0, q) is None
+        assert apair.backend() == "numpy" and chain._fast.call(0, q) is None
+        np.testing.assert_allclose(chain.fk(q), c, atol=1e-15)
+    finally:
+        apair.set_backend(None)
+    chain.fk(q)
+    assert chain._fast.call(0, q) is not None
+
+
+@gcc
+def test_committed_example_code_builds_and_passes_its_selftest(tmp_path):
+    """examples/codegen/chain4a (regenerated by make, compared by make check) as a user builds it."""
+    folder = ROOT / "examples" / "codegen" / "chain4a"
+    exe = tmp_path / "selftest"
+    run(["cc", "-std=c99", *STRICT, str(folder / "chain4a_selftest.c"), str(folder / "chain4a.c"), "-o", str(exe), "-lm"])
+    assert "checks passed" in run([str(exe)]).stdout

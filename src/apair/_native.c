@@ -189,6 +189,7 @@ typedef struct {
     const apair_kernel *kernel; /* NULL: the method has no kernel here */
     int strict;                 /* needs every ranged joint strictly inside its range (d' finite) */
     int source[MAX_ARGS];       /* per kernel input: SRC_* or the index of a design array */
+    double *inv;                /* the kernel's design invariants (its split form), or NULL */
 } chain_method;
 
 typedef struct {
@@ -208,6 +209,9 @@ typedef struct {
 static void chain_dealloc(ChainObject *self)
 {
     int i;
+    for (i = 0; i < self->n_methods; ++i) {
+        PyMem_Free(self->methods[i].inv);
+    }
     for (i = 0; i < self->n_design; ++i) {
         Py_XDECREF(self->design[i]);
     }
@@ -336,6 +340,19 @@ static int chain_init(ChainObject *self, PyObject *args, PyObject *kwds)
                 self->design[self->n_design++] = arr;
             }
             m->source[j] = d;
+        }
+        if (m->kernel->n_invariants > 0 && m->kernel->invariants != NULL && m->kernel->core != NULL) {
+            /* the design never changes: its invariants once, here, and single items go to the core */
+            const double *in[MAX_ARGS];
+            m->inv = (double *)PyMem_Malloc(sizeof(double) * (size_t)m->kernel->n_invariants);
+            if (m->inv == NULL) {
+                PyErr_NoMemory();
+                return -1;
+            }
+            for (j = 0; j < m->kernel->n_inputs; ++j) {
+                in[j] = m->source[j] >= 0 ? (const double *)PyArray_DATA((PyArrayObject *)self->design[m->source[j]]) : NULL;
+            }
+            m->kernel->invariants(in, m->inv);
         }
     }
     return 0;
@@ -510,7 +527,9 @@ static PyObject *chain_call(ChainObject *self, PyObject *const *args, Py_ssize_t
         if (self->uses_law) {
             fill_law(self, given[0] + done * (size_t)self->n, m_items, law);
         }
-        if (count == 1) {
+        if (count == 1 && m->inv != NULL) {
+            k->core(m->inv, in, outp);
+        } else if (count == 1) {
             k->eval(in, outp);
         } else {
             double *o[1];

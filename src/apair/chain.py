@@ -68,16 +68,21 @@ class AChain:
         self._ranged = [i for i, p in enumerate(pairs) if p.theta_limit is not None]  # angles to check
         self._ik = None  # the inverse-kinematics solver, built on the first call of ik()
         self._explicit_limits = self._check_limits(limits)
-        self._fast = self._native_chain()
+        self._use(self._native_chain())
+
+    def _use(self, fast) -> None:
+        """Take `fast` (kernels.native_chain) as the methods' fast path; its bound call is kept,
+        since an attribute lookup less is measurable at single calls."""
+        self._fast, self._call = fast, fast.call
 
     def __getstate__(self):
         state = dict(self.__dict__)
-        del state["_fast"]  # a native object: rebuilt on unpickling
+        del state["_fast"], state["_call"]  # native objects: rebuilt on unpickling
         return state
 
     def __setstate__(self, state):
         self.__dict__.update(state)
-        self._fast = self._native_chain()
+        self._use(self._native_chain())
 
     def _check_limits(self, limits):
         if limits is None:
@@ -206,7 +211,7 @@ class AChain:
         the argument), then the fast path again, else the law kernels and the generic kernel of
         `family` with the `design` inputs after the state."""
         arrays = self._state(q, strict, **named)
-        out = self._fast.call(method, *arrays)
+        out = self._call(method, *arrays)
         if out is None:
             law = self._law(arrays[0])
             if strict and not np.isfinite(law).all():
@@ -216,48 +221,48 @@ class AChain:
 
     def fk(self, q) -> np.ndarray:
         """(..., 4, 4): the pose of frame n in the base frame; q is (n,) or (..., n)."""
-        out = self._fast.call(0, q)
+        out = self._call(0, q)
         return out if out is not None else self._evaluate(0, "fk", q, (self._dh,), strict=False)
 
     def fk_study(self, q) -> np.ndarray:
         """(..., 8): the Study point (x0..x3, y0..y3) of fk(q), with |x| = 1; (x, y) ~ (−x, −y)."""
-        out = self._fast.call(1, q)
+        out = self._call(1, q)
         return normalise(out if out is not None else self._evaluate(1, "fk_study", q, (self._dh,), strict=False))
 
     def jacobian(self, q) -> np.ndarray:
         """(..., 6, n): geometric Jacobian, base frame, rows [v; ω] (v of the origin of frame n)."""
-        out = self._fast.call(2, q)
+        out = self._call(2, q)
         return out if out is not None else self._evaluate(2, "jacobian", q, (self._dh,))
 
     # ----------------------------------------------------------------------------- dynamics
     def mass_matrix(self, q) -> np.ndarray:
         """(..., n, n): M(θ), legs included."""
-        out = self._fast.call(3, q)
+        out = self._call(3, q)
         return out if out is not None else self._evaluate(3, "mass_matrix", q, self._body[:3])
 
     def coriolis_matrix(self, q, qd) -> np.ndarray:
         """(..., n, n): C(θ, θ') in Christoffel form (Ṁ − 2C is skew-symmetric)."""
-        out = self._fast.call(4, q, qd)
+        out = self._call(4, q, qd)
         return out if out is not None else self._evaluate(4, "coriolis", q, self._body[:3], qd=qd)
 
     def gravity_torques(self, q) -> np.ndarray:
         """(..., n): g(θ) = ∂V/∂θ."""
-        out = self._fast.call(5, q)
+        out = self._call(5, q)
         return out if out is not None else self._evaluate(5, "gravity", q, self._body)
 
     def bias(self, q, qd) -> np.ndarray:
         """(..., n): C(θ, θ')θ' + g(θ)."""
-        out = self._fast.call(6, q, qd)
+        out = self._call(6, q, qd)
         return out if out is not None else self._evaluate(6, "bias", q, self._body, qd=qd)
 
     def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
         """(..., n): τ = M(θ)θ'' + C(θ, θ')θ' + g(θ), torques about the pair axes."""
-        out = self._fast.call(7, q, qd, qdd)
+        out = self._call(7, q, qd, qdd)
         return out if out is not None else self._evaluate(7, "inverse_dynamics", q, self._body, qd=qd, qdd=qdd)
 
     def forward_dynamics(self, q, qd, tau) -> np.ndarray:
         """(..., n): θ'' = M⁻¹(τ − C θ' − g), by a Cholesky factorisation of M inside one kernel."""
-        out = self._fast.call(8, q, qd, tau)
+        out = self._call(8, q, qd, tau)
         if out is None:
             out = self._evaluate(8, "forward_dynamics", q, self._body, qd=qd, tau=tau)
             if not np.isfinite(out).all():
@@ -267,7 +272,7 @@ class AChain:
 
     def energy(self, q, qd) -> np.ndarray:
         """(..., 2): kinetic and potential energy (T, V) [J], legs included."""
-        out = self._fast.call(9, q, qd)
+        out = self._call(9, q, qd)
         return out if out is not None else self._evaluate(9, "energy", q, self._body, qd=qd)
 
     @property

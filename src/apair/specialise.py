@@ -97,10 +97,13 @@ def check_kernels(kernels) -> tuple[str, ...]:
     return tuple(k for k in specialised.KERNELS if k in kernels)
 
 
-def lowered(chain, kernels) -> list:
-    """The chain's specialised kernels, derived and lowered (CSE, printed)."""
+def lowered(chain, kernels) -> tuple[list, dict]:
+    """The chain's specialised kernels, derived and lowered (CSE, printed), and the parts they
+    call by name."""
     specialised, emitter = _toolkit()
-    return [emitter.lower(s) for s in specialised.chain_specs(design_of(chain), kernels)]
+    specs = specialised.chain_specs(design_of(chain), kernels)
+    parts = {c.kernel.name: emitter.lower(c.kernel) for s in specs for c in s.calls}
+    return [emitter.lower(s) for s in specs], parts
 
 
 def _states(chain, count: int, seed: int) -> dict[str, np.ndarray]:
@@ -146,7 +149,7 @@ def render(chain, name: str, origin: str, kernels=None, title: str | None = None
     _, emitter = _toolkit()
     name = check_prefix(name)
     kernels = check_kernels(kernels)
-    code = code or lowered(chain, kernels)
+    code, parts = code or lowered(chain, kernels)
     tests = references(chain, code)
     by_name = {k.name: k for k in code}
     joints, ranges = _describe(chain)
@@ -155,7 +158,7 @@ def render(chain, name: str, origin: str, kernels=None, title: str | None = None
     origin = re.sub(r"[^\w .,:+/-]", "_", origin)[:120]
     meta = {"title": title, "origin": origin, "joints": joints, "ranges": ranges,
             "n": chain.n, "hash": content_hash(chain, kernels)}
-    return emitter.Emitter().render_chain(code, name, meta, [dict(t, kernel=by_name[t["name"]]) for t in tests])
+    return emitter.Emitter().render_chain(code, parts, name, meta, [dict(t, kernel=by_name[t["name"]]) for t in tests])
 
 
 def write_code(chain, out, name: str, origin: str, kernels=None, title: str | None = None) -> list[str]:
@@ -225,7 +228,7 @@ def build(chain, kernels=None) -> tuple[Path, str, tuple[str, ...]] | None:
     _, emitter = _toolkit()
     code = lowered(chain, kernels)
     files = render(chain, name, "AChain.specialise()", kernels, code=code)
-    files[f"{name}_registry.c"] = emitter.Emitter().render_chain_registry(code, name, digest)
+    files[f"{name}_registry.c"] = emitter.Emitter().render_chain_registry(code[0], name, digest)
     folder.parent.mkdir(parents=True, exist_ok=True)
     include = Path(_kernels.__file__).parent / "generated" / "c"
     with tempfile.TemporaryDirectory(dir=folder.parent, prefix=f".{digest}-") as tmp:
@@ -282,7 +285,7 @@ class SpecialisedChain(AChain):
     C compiler), the generic kernels serve, as said once in a warning."""
 
     def __init__(self, chain: AChain, kernels=None):
-        self.__dict__.update({k: v for k, v in chain.__dict__.items() if k != "_fast"})
+        self.__dict__.update({k: v for k, v in chain.__dict__.items() if k not in ("_fast", "_call")})
         self._kernels = check_kernels(kernels)
         self.content_hash = content_hash(chain, self._kernels)
         self._attach()
@@ -290,11 +293,11 @@ class SpecialisedChain(AChain):
     def _attach(self) -> None:
         """The specialised fast path (building it on first use; the references of its self-test
         come from the generic kernels, which serve until then)."""
-        self._fast = self._native_chain()
+        self._use(self._native_chain())
         fast = load(self, self._kernels)
         self.specialised = fast is not None
         if fast is not None:
-            self._fast = fast
+            self._use(fast)
 
     def __setstate__(self, state):
         self.__dict__.update(state)
