@@ -270,24 +270,25 @@ def time_generate() -> float:
 def time_codegen(chain) -> float:
     """Wall time of `apair codegen` (every kernel) for a 6-joint chain in a fresh process: the chain
     is written as a chain file first."""
+    num = lambda x: repr(float(x))
+    lines = [f"gravity = [{', '.join(map(num, chain.gravity))}]", ""]  # top-level keys before the tables
+    for p, a, al, c, ph, link in zip(chain.pairs, chain.a, chain.alpha, chain.offset, chain.theta_offset, chain.links):
+        lines += ["[[joint]]", f'pair = "{p.kind}"']
+        if p.kind != "revolute":
+            lines += [f"base_radius = {num(p.base_radius)}", f"platform_radius = {num(p.platform_radius)}",
+                      f"leg_mass = {num(p.leg_mass)}"]
+        I = link.inertia
+        lines += [f"a = {num(a)}", f"alpha = {num(al)}", f"offset = {num(c)}", f"theta_offset = {num(ph)}",
+                  f"mass = {num(link.mass)}", f"com = [{', '.join(map(num, link.com))}]",
+                  f"inertia = [{', '.join(map(num, (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])))}]", ""]
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "arm6.toml"
-        lines = []
-        for p, a, al, c, ph, link in zip(chain.pairs, chain.a, chain.alpha, chain.offset, chain.theta_offset,
-                                         chain.links):
-            lines += ["[[joint]]", f'pair = "{p.kind}"']
-            if p.kind != "revolute":
-                lines += [f"base_radius = {p.base_radius!r}", f"platform_radius = {p.platform_radius!r}",
-                          f"leg_mass = {p.leg_mass!r}"]
-            I = link.inertia
-            lines += [f"a = {a!r}", f"alpha = {al!r}", f"offset = {c!r}", f"theta_offset = {ph!r}",
-                      f"mass = {link.mass!r}", f"com = {link.com.tolist()!r}",
-                      f"inertia = {[I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]!r}", ""]
-        lines.append(f"gravity = {chain.gravity.tolist()!r}")
-        path.write_text("\n".join(lines) + "\n")
+        path.write_text("\n".join(lines))
         t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "apair", "codegen", str(path), "--out", str(Path(tmp) / "out")],
-                       check=True, capture_output=True)
+        res = subprocess.run([sys.executable, "-m", "apair", "codegen", str(path), "--out", str(Path(tmp) / "out")],
+                             capture_output=True, text=True)
+        if res.returncode != 0:
+            raise RuntimeError(f"apair codegen failed: {res.stderr.strip()}")
         return time.perf_counter() - t0
 
 

@@ -1,9 +1,10 @@
 """`AChain`: a serial chain of R- and A-pairs in the DH convention of docs/conventions.md §3.
 
-Joint i: A_i(θ_i) = Rz(θ_i + φ_i) · Tz(c_i + d_i(θ_i)) · Tx(a_i) · Rx(α_i). Each method computes
+Joint i: A_i(θ_i) = Rz(θ_i + φ_i) · Tz(c_i + d_i(θ_i)) · Tx(a_i) · Rx(α_i). Each method evaluates
 the joints' law values (cos(θ/2), sin(θ/2), d, d', d'') with their pairs' kernels and hands them
-to one generated chain kernel for n joints (derivations/chain_kinematics.py, chain_dynamics.py);
-batches stay in the kernels.
+to one generated chain kernel for n joints (derivations/chain_kinematics.py, chain_dynamics.py),
+in one native call (apair.kernels.native_chain) when the inputs are canonical float64 arrays;
+otherwise the validating path checks and converts them first. Batches stay in the kernels.
 """
 from __future__ import annotations
 
@@ -150,12 +151,11 @@ class AChain:
                                                    for k in range(values.shape[1])]))
         return groups
 
-    def _native_chain(self, kernel=lambda family, n: f"{family}{n}", law: bool = True):
-        """The native fast path of the methods (apair.kernels.native_chain): per method the
-        kernel `kernel(family, n)`, fed by the pairs' law kernels when `law`."""
+    def _native_chain(self):
+        """The native fast path of the methods (apair.kernels.native_chain): per method its
+        generic chain kernel, fed by the pairs' law kernels."""
         return native_chain(
-            self.n, [(kernel(family, self.n), strict) for family, strict in METHODS],
-            [p.law_kernel for p in self.pairs] if law else [],
+            self.n, [(f"{family}{self.n}", strict) for family, strict in METHODS], [p.law_kernel for p in self.pairs],
             [p.theta_limit if p.theta_limit is not None else math.inf for p in self.pairs],
             {"dh": self._dh, "links": self._links, "legs": self._legs, "gravity": self._gravity})
 
@@ -185,26 +185,19 @@ class AChain:
         """Validated, snapped q and the named (n,)-arrays (qd, qdd, tau), broadcast to one batch
         shape, C-contiguous; with `strict`, a joint at its range end (where d' is unbounded) is
         refused."""
-        q = self._snapped(self._q(q))
-        if not named:
-            return [np.ascontiguousarray(q)] + ([] if not strict else self._refuse_range_ends(q))
-        arrays = [q] + [self._q(x, name) for name, x in named.items()]
+        arrays = [self._snapped(self._q(q))] + [self._q(x, name) for name, x in named.items()]
         try:
             shape = np.broadcast_shapes(*(x.shape for x in arrays))
         except ValueError:
             first = next(iter(named))
             raise ValueError(f"{first}: batch shape does not match q: {[x.shape for x in arrays]}") from None
         arrays = [np.ascontiguousarray(np.broadcast_to(x, shape)) for x in arrays]
-        return arrays + (self._refuse_range_ends(arrays[0]) if strict else [])
-
-    def _refuse_range_ends(self, q: np.ndarray) -> list:
-        """Refuses a joint at its range end (up to rounding), where d' is unbounded; returns []."""
-        for i in self._ranged:
-            t = q[..., i]
+        for i in self._ranged if strict else ():  # at the range end (up to rounding) d' is unbounded
+            t = arrays[0][..., i]
             t = np.abs(t - 2 * np.pi * np.round(t / (2 * np.pi)))
             if np.any(t >= self.pairs[i].theta_limit):
                 raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
-        return []
+        return arrays
 
     def _evaluate(self, method: int, family: str, q, design, strict: bool = True, **named) -> np.ndarray:
         """The validating path of a method: checks and converts the inputs (a ValueError names

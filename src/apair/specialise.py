@@ -27,7 +27,7 @@ SELFTEST_STATES = 4
 
 
 def _toolkit():
-    from . import codegen, derivations  # noqa: F401  (the installed copies of the source tree's packages)
+    """derivations.specialised and codegen.emitter, as installed with the runtime."""
     from .codegen import emitter
     from .derivations import specialised
 
@@ -49,11 +49,13 @@ def design_of(chain):
 @lru_cache(maxsize=None)
 def toolkit_digest() -> str:
     """SHA-256 of what turns a design into code: the derivations, the code generator with its
-    templates, and the sympy version (its printing and evaluation shape the output)."""
+    templates, apair's and sympy's versions (sympy's printing and evaluation shape the output)."""
     import sympy
 
+    from . import __version__
+
     root = Path(__file__).resolve().parent
-    h = hashlib.sha256(f"sympy {sympy.__version__}\0".encode())
+    h = hashlib.sha256(f"apair {__version__} sympy {sympy.__version__}\0".encode())
     for folder in ("derivations", "codegen", "codegen/templates"):
         for path in sorted((root / folder).glob("*")):
             if path.is_file() and path.suffix in (".py", ".j2"):
