@@ -2,7 +2,8 @@
 
 `lower` turns a KernelSpec into straight-line code (assignments after common-subexpression
 elimination), printed for C and NumPy; `Emitter.render` hands the lowered kernels of each
-derivation to the templates in codegen/templates and returns {relative path: text}. Lowering is
+derivation to the templates in codegen/templates and returns {relative path: text};
+`Emitter.render_chain` does the same for one chain's specialised kernels (`apair codegen`). Lowering is
 the expensive part and is independent per kernel, so codegen/__main__.py runs it in parallel.
 Output is deterministic: the same specs give byte-identical files, each naming the derivation that
 produced it and a content hash of its inputs (the kernel specs and the template).
@@ -27,7 +28,6 @@ Arg, KernelSpec, PolynomialSet = _spec.Arg, _spec.KernelSpec, _spec.PolynomialSe
 
 TEMPLATES = Path(__file__).parent / "templates"
 PREFIX = "apair_"
-# The package version, stamped into the C library (header, CMake, pkg-config).
 
 
 def _version() -> str:
@@ -40,7 +40,7 @@ def _version() -> str:
     return version("apair")
 
 
-VERSION = _version()
+VERSION = _version()  # stamped into the C library (header, CMake, pkg-config)
 
 
 @dataclass
@@ -350,7 +350,6 @@ class Emitter:
         manifest["files"] = sorted(set(files) | {"manifest.json"})  # what a later run may replace or remove
         files["manifest.json"] = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
         return files
-
 
     def render_chain(self, kernels: list[Lowered], parts: dict[str, Lowered], name: str, meta: dict,
                      tests: list[dict]) -> dict[str, str]:

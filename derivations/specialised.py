@@ -213,7 +213,7 @@ def specialise(spec: KernelSpec, design: Design, name: str, doc: str, zeros=(), 
 def generic_specs(n: int, families) -> dict[str, KernelSpec]:
     """The generic kernels of an n-joint chain for the requested families, by family."""
     out = {}
-    if any(f in ("fk", "fk_study", "jacobian") for f in families):
+    if any(f in KINEMATIC for f in families):
         out.update({"fk": chain_kinematics.fk_spec(n), "fk_study": chain_kinematics.fk_study_spec(n),
                     "jacobian": chain_kinematics.jacobian_spec(n)})
     if any(f not in out for f in families):

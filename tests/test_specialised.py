@@ -185,17 +185,12 @@ def test_cli_codegen_writes_refuses_and_explains(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------------ AChain.specialise, fast path
-@pytest.fixture(scope="module")
-def cache(tmp_path_factory):
+@pytest.fixture
+def cache() -> Path:
+    """The compiled chains' cache of this test session (conftest points APAIR_CACHE at it)."""
     import os
 
-    old = os.environ.get("APAIR_CACHE")
-    os.environ["APAIR_CACHE"] = str(tmp_path_factory.mktemp("cache"))
-    yield Path(os.environ["APAIR_CACHE"])
-    if old is None:
-        del os.environ["APAIR_CACHE"]
-    else:
-        os.environ["APAIR_CACHE"] = old
+    return Path(os.environ["APAIR_CACHE"])
 
 
 METHODS = ["fk", "fk_study", "jacobian", "mass_matrix", "coriolis_matrix", "gravity_torques", "bias",
