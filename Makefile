@@ -8,7 +8,7 @@ DEPS_STAMP := $(VENV)/.deps-stamp
 CFLAGS_STRICT := -std=c99 -Wall -Wextra -Werror -pedantic -O2
 CHECK_DIR := build/check-generated
 
-.PHONY: all venv generate install varieties lib examples demo check test bench clean
+.PHONY: all venv generate install varieties lib examples demo check test bench clean ik-counts
 
 all: generate install varieties lib examples demo
 
@@ -77,6 +77,11 @@ $(BENCH_STAMP): pyproject.toml | $(DEPS_STAMP)
 	$(PY) -m pip install --quiet $$($(PY) -c "import tomllib; print(' '.join(\
 	  tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['bench']))")
 	touch $@
+
+# The generic inverse-kinematics solution counts of every R/A pattern (apair show ik_counts):
+# monodromy on a random design of each pattern, slower than `make` (tens of minutes).
+ik-counts: install
+	$(PY) -m apair.ikcounts src/apair/data/ik_counts.json
 
 bench: install $(BENCH_STAMP)
 	PYTHONPATH=. $(PY) bench/run.py $(BENCH_ARGS)

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import subprocess
 import sys
@@ -419,6 +420,65 @@ def time_ik(chains, poses_per_chain: int, rng) -> dict:
             "first_call_ms": float(np.median(setup) * 1e3), "solutions_per_pose": float(np.mean(solutions))}
 
 
+def random_pattern_chain(pattern: str, rng) -> apair.AChain:
+    n = len(pattern)
+    pairs = [apair.APair.revolute() if c == "R" else apair.APair(*rng.uniform(0.05, 0.12, 2)) for c in pattern]
+    return apair.AChain(pairs, rng.uniform(0.1, 0.5, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.2, 0.2, n),
+                        rng.uniform(-1.0, 1.0, n))
+
+
+def time_ik6(pattern: str, poses: int, rng) -> dict:
+    """6-joint IK: the start system's preparation (into an empty cache), then every real solution at
+    `poses` random poses: median and worst per pose, and whether each pose's solution was found."""
+    chain = random_pattern_chain(pattern, rng)
+    old = os.environ.get("APAIR_CACHE")
+    with tempfile.TemporaryDirectory() as tmp:
+        os.environ["APAIR_CACHE"] = tmp
+        try:
+            t0 = time.perf_counter()
+            start = chain.prepare_ik()
+            prep = time.perf_counter() - t0
+            qs = rng.uniform(-np.pi, np.pi, (poses, 6))
+            t0 = time.perf_counter()
+            chain.ik(chain.fk(qs[0]))  # the first call loads the start system from the cache
+            first = time.perf_counter() - t0
+            times, found, certified = [], 0, 0
+            for q in qs:
+                T = chain.fk(q)
+                t0 = time.perf_counter()
+                sol = chain.ik(T, full=True)
+                times.append(time.perf_counter() - t0)
+                per = np.array([2 * np.pi if p.kind == "revolute" else 4 * np.pi for p in chain.pairs])
+                d = np.abs((sol.q - q + per / 2) % per - per / 2)
+                found += bool(len(sol.q)) and bool(np.any(np.all(d < 1e-7, axis=1)))
+                certified += sol.certified
+        finally:
+            if old is None:
+                os.environ.pop("APAIR_CACHE", None)
+            else:
+                os.environ["APAIR_CACHE"] = old
+    ms = np.array(times) * 1e3
+    return {"pattern": pattern, "poses": poses, "median_ms": float(np.median(ms)), "max_ms": float(ms.max()),
+            "prepare_s": prep, "first_call_ms": first * 1e3, "start_count": start.count, "start_certified": start.certified,
+            "round_trips_found": found, "certified_poses": certified}
+
+
+def time_ik_local(rng, count: int = 2000) -> dict:
+    """ik_local, n = 6 R-chain, seeds within 0.3 rad of a solution: µs per converged solve."""
+    chain = random_pattern_chain("RRRRRR", rng)
+    q = rng.uniform(-np.pi + 0.3, np.pi - 0.3, (count, 6))  # the seeds stay inside the limits (−π, π)
+    T = chain.fk(q)
+    seeds = q + rng.uniform(-0.3, 0.3, q.shape)
+    chain.ik_local(T[:10], seeds[:10])
+    best = np.inf
+    for _ in range(5):
+        t0 = time.perf_counter()
+        res = chain.ik_local(T, seeds)
+        best = min(best, time.perf_counter() - t0)
+    return {"count": count, "us_per_solve": best / count * 1e6, "converged": float(res.converged.mean()),
+            "us_per_converged": best / max(res.converged.sum(), 1) * 1e6}
+
+
 # ------------------------------------------------------------------------------------ report
 def fmt(ns: float) -> str:
     return f"{ns / 1e6:.3g} ms" if ns >= 1e6 else f"{ns / 1e3:.3g} µs" if ns >= 1e3 else f"{ns:.3g} ns"
@@ -454,6 +514,18 @@ def targets(results: dict) -> list[dict]:
     if results.get("make_generate_s") is not None:
         g = results["make_generate_s"]
         out.append({"target": "make generate < 120 s", "measured": g, "met": g < 120})
+    for pattern, bound in (("RRRRRR", 1.0), ("ARRRRR", 5.0), ("AAAAAA", 1000.0)):
+        r = results.get("ik6", {}).get(pattern)
+        if r:
+            out.append({"target": f"ik of a 6-joint {pattern} chain, all solutions, median per pose <= {bound:g} ms",
+                        "measured": r["median_ms"], "met": r["median_ms"] <= bound})
+    if results.get("ik_local"):
+        r = results["ik_local"]["us_per_converged"]
+        out.append({"target": "ik_local, n = 6, seed within 0.3 rad: <= 20 µs per converged solve", "measured": r,
+                    "met": r <= 20})
+    for name, r in results.get("ik", {}).items():
+        out.append({"target": f"4-joint ik ({name}) <= 1 ms median", "measured": r["median_ms"],
+                    "met": r["median_ms"] <= 1.0})
     return out
 
 
@@ -500,6 +572,9 @@ def main(argv=None) -> int:
     cases = {"4A random generic designs": ([random_4a(rng) for _ in range(3 if args.quick else 10)], 10 if args.quick else 50),
              "examples/4a_chain.toml": ([apair.load(ROOT / "examples/4a_chain.toml")], 20 if args.quick else 200)}
     results["ik"] = {name: time_ik(chains, k, rng) for name, (chains, k) in cases.items()}
+    results["ik6"] = {p: time_ik6(p, 20 if args.quick else 100, rng)
+                      for p in ("RRRRRR", "ARRRRR") + (() if args.quick else ("AAAAAA",))}
+    results["ik_local"] = time_ik_local(rng)
     results["make_generate_s"] = None if args.no_generate else time_generate()
     results["codegen_6_s"] = time_codegen(random_achain(6, rng))
     results["targets"] = targets(results)
@@ -527,6 +602,13 @@ def main(argv=None) -> int:
     for name, r in results["ik"].items():
         print(f"  {name:30s} median {r['median_ms']:.2f} ms (min {r['min_ms']:.2f}, max {r['max_ms']:.2f}; "
               f"{r['solutions_per_pose']:.1f} solutions)")
+    for p, r in results["ik6"].items():
+        print(f"  6-joint {p:24s} median {r['median_ms']:.2f} ms, worst {r['max_ms']:.2f} ms over {r['poses']} poses "
+              f"({r['round_trips_found']} round trips found, {r['certified_poses']} certified); start system "
+              f"{r['start_count']} solutions ({'certified' if r['start_certified'] else 'not certified'}) prepared "
+              f"in {r['prepare_s']:.1f} s")
+    r = results["ik_local"]
+    print(f"  ik_local n = 6: {r['us_per_converged']:.2f} µs per converged solve ({r['converged']:.1%} converged)")
     if results["make_generate_s"] is not None:
         print(f"\nmake generate (derivations + code generation): {results['make_generate_s']:.1f} s")
     worst = max(v for rows in results["kernels"].values() for row in rows.values()

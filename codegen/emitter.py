@@ -313,7 +313,11 @@ class Emitter:
             c_hash = content_hash([src_src, fingerprints[k.name]] + [fingerprints[c.kernel] for c in k.calls])
             files[f"c/{k.name}.c"] = src_t.render(kernels=[k], source=k.spec.source, hash=c_hash, prefix=PREFIX,
                                                   by_name=by_name, called=called, inv_sizes=inv_sizes)
-        c_sources = sorted(["apair_registry.c"] + [f"{k.name}.c" for k in all_kernels])
+        ik_t, ik_src = self._template("ik.c.j2")
+        ik_inv = [inv_sizes.get(k.name, 0) for k in all_kernels if k.name.startswith("ik_system")]
+        files["c/apair_ik.c"] = ik_t.render(prefix=PREFIX, inv_max=max(ik_inv + [1]),
+                                            hash=content_hash([ik_src, str(max(ik_inv + [1]))]))
+        c_sources = sorted(["apair_registry.c", "apair_ik.c"] + [f"{k.name}.c" for k in all_kernels])
         # the header's hash covers every C source the binding compiles (so their templates too)
         header_hash = content_hash([header_src, VERSION] + [fingerprints[k.name] for k in all_kernels]
                                    + [files[f"c/{c}"] for c in c_sources] + [files["c/apair_internal.h"]])

@@ -58,9 +58,13 @@ def at_angles(J: list[dict]) -> dict:
 
 
 def joint_trig(j: dict, rec: "_Recorder", label: str) -> tuple[sp.Expr, sp.Expr, sp.Expr, sp.Expr]:
-    """(cos θ, sin θ, cos(θ + φ), sin(θ + φ)) of joint j as steps, from the half-angle law values."""
-    ct = rec.name(f"ct{label}", j["ch"] ** 2 - j["sh"] ** 2)
-    st = rec.name(f"st{label}", 2 * j["ch"] * j["sh"])
+    """(cos θ, sin θ, cos(θ + φ), sin(θ + φ)) of joint j as steps, from the half-angle law values
+    (or from cos θ, sin θ themselves where j has them: the inverse-kinematics system's inputs)."""
+    if "ct" in j:
+        ct, st = j["ct"], j["st"]
+    else:
+        ct = rec.name(f"ct{label}", j["ch"] ** 2 - j["sh"] ** 2)
+        st = rec.name(f"st{label}", 2 * j["ch"] * j["sh"])
     cp, sp_ = sp.cos(j["phi"]), sp.sin(j["phi"])
     return ct, st, rec.name(f"cq{label}", ct * cp - st * sp_), rec.name(f"sq{label}", st * cp + ct * sp_)
 

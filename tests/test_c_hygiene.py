@@ -319,6 +319,8 @@ def test_no_allocation_io_or_mutable_state_in_the_library():
         text = path.read_text()
         assert not re.search(r"\b(malloc|calloc|realloc|free|alloca|printf|fopen|exit|abort)\s*\(", text), path
         for line in text.splitlines():
+            if re.match(r"^static\s+(inline\s+)?(const\s+)?[A-Za-z_][\w\s\*]*\b\w+\(", line):
+                continue  # a function of file scope, not state
             if line.startswith(("static ", "extern ")) or re.match(r"^(double|int|float|char|size_t)\b.*[=;]\s*$", line):
                 assert line.startswith(("static void", "static const", "extern const", "extern \"C\"")), (path, line)
 

@@ -28,6 +28,16 @@ def random_inputs(spec, rng: np.random.Generator, count: int) -> list[np.ndarray
         law = out[names.index("law")]
         half = rng.uniform(-np.pi, np.pi, law.shape[:-1])
         law[..., 0], law[..., 1] = np.cos(half), np.sin(half)
+    if spec.name.startswith("ik_"):  # the homotopy's kernels at a complex angle θ, |Im θ| <= 1
+        dims = (count,) + spec.inputs[0].shape[:-2 if spec.name.startswith("ik_system") else -1]
+        theta = rng.uniform(-np.pi, np.pi, dims) + 1j * rng.uniform(-1, 1, dims)
+        if spec.name.startswith("ik_law"):
+            v = np.exp(0.5j * theta)
+            out[0] = np.stack([v.real, v.imag], -1)
+        else:
+            h = rng.uniform(0.0, 0.3, theta.shape)
+            vals = np.stack([np.cos(theta / 2), np.sin(theta / 2), h * np.cos(theta / 2), -h / 2 * np.sin(theta / 2)], -1)
+            out[0] = np.stack([vals.real, vals.imag], -1)
     if spec.name.startswith("forward_dynamics"):  # physical links: M is positive definite
         links = out[[a.name for a in spec.inputs].index("links")]
         links[..., 0] = rng.uniform(0.5, 3.0, links.shape[:-1])

@@ -591,12 +591,146 @@ static PyObject *native_kernel_address(PyObject *self, PyObject *index)
     return PyLong_FromVoidPtr((void *)&apair_kernels[i]);
 }
 
+/* ------------------------------------------------------------------ inverse kinematics */
+
+static PyArrayObject *ik_array(PyObject *obj, int type, int nd, const npy_intp *shape, const char *what)
+{
+    PyArrayObject *a = (PyArrayObject *)PyArray_FROM_OTF(obj, type, NPY_ARRAY_IN_ARRAY);
+    if (a == NULL) {
+        return NULL;
+    }
+    if (PyArray_NDIM(a) != nd) {
+        PyErr_Format(PyExc_ValueError, "%s: expected %d dimensions", what, nd);
+        Py_DECREF(a);
+        return NULL;
+    }
+    for (int d = 0; d < nd; d++) {
+        if (shape[d] >= 0 && PyArray_DIM(a, d) != shape[d]) {
+            PyErr_Format(PyExc_ValueError, "%s: dimension %d is %zd, expected %zd", what, d,
+                         (Py_ssize_t)PyArray_DIM(a, d), (Py_ssize_t)shape[d]);
+            Py_DECREF(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+/* ik_track(kind, pair, dh, p0, p1, gamma, start) -> (end, status, steps, cond) */
+static PyObject *native_ik_track(PyObject *self, PyObject *args)
+{
+    PyObject *o[9];
+    PyArrayObject *a[9] = {NULL};
+    PyObject *result = NULL;
+    Py_complex gamma;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOODO", &o[0], &o[1], &o[2], &o[5], &o[6], &gamma, &o[8])) {
+        return NULL;
+    }
+    npy_intp nk[1] = {-1};
+    if (!(a[0] = ik_array(o[0], NPY_INT32, 1, nk, "kind"))) goto done;
+    npy_intp n = PyArray_DIM(a[0], 0);
+    if (n != 6) {
+        PyErr_SetString(PyExc_ValueError, "kind: 6 joints");
+        goto done;
+    }
+    npy_intp s_pair[2] = {n, 2}, s_dh[2] = {n, 4}, s_p[1] = {7}, s_start[2] = {-1, n};
+    if (!(a[1] = ik_array(o[1], NPY_DOUBLE, 2, s_pair, "pair")) || !(a[2] = ik_array(o[2], NPY_DOUBLE, 2, s_dh, "dh")) ||
+        !(a[5] = ik_array(o[5], NPY_CDOUBLE, 1, s_p, "p0")) || !(a[6] = ik_array(o[6], NPY_CDOUBLE, 1, s_p, "p1")) ||
+        !(a[8] = ik_array(o[8], NPY_CDOUBLE, 2, s_start, "start"))) {
+        goto done;
+    }
+    npy_intp count = PyArray_DIM(a[8], 0), s_out[2] = {count, n};
+    PyArrayObject *end = (PyArrayObject *)PyArray_SimpleNew(2, s_out, NPY_CDOUBLE);
+    PyArrayObject *status = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
+    PyArrayObject *steps = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
+    PyArrayObject *cond = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_DOUBLE);
+    if (!end || !status || !steps || !cond) {
+        Py_XDECREF(end); Py_XDECREF(status); Py_XDECREF(steps); Py_XDECREF(cond);
+        goto done;
+    }
+    apair_ik_problem pb = {(int)n, (const int *)PyArray_DATA(a[0]), PyArray_DATA(a[1]), PyArray_DATA(a[2])};
+    apair_ik_options opt;
+    apair_ik_default_options(&opt);
+    double g[2] = {gamma.real, gamma.imag};
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = apair_ik_track(&pb, &opt, PyArray_DATA(a[5]), PyArray_DATA(a[6]), g, (size_t)count, PyArray_DATA(a[8]),
+                        PyArray_DATA(end), PyArray_DATA(status), PyArray_DATA(steps), PyArray_DATA(cond));
+    Py_END_ALLOW_THREADS
+    if (rc) {
+        PyErr_SetString(PyExc_ValueError, "ik_track: the problem is not valid (kinds 0 or 1, 6 joints)");
+        Py_DECREF(end); Py_DECREF(status); Py_DECREF(steps); Py_DECREF(cond);
+        goto done;
+    }
+    result = Py_BuildValue("NNNN", end, status, steps, cond);
+done:
+    for (int i = 0; i < 9; i++) Py_XDECREF(a[i]);
+    return result;
+}
+
+/* ik_local(kind, pair, dh, lower, upper, scale, target (count, 4, 4), seed (count, n), tol, max_iter)
+ * -> (q, residual, converged) */
+static PyObject *native_ik_local(PyObject *self, PyObject *args)
+{
+    PyObject *o[8];
+    PyArrayObject *a[8] = {NULL};
+    PyObject *result = NULL;
+    double scale, tol;
+    int max_iter;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOdOOdi", &o[0], &o[1], &o[2], &o[3], &o[4], &scale, &o[6], &o[7], &tol, &max_iter)) {
+        return NULL;
+    }
+    npy_intp nk[1] = {-1};
+    if (!(a[0] = ik_array(o[0], NPY_INT32, 1, nk, "kind"))) goto done;
+    npy_intp n = PyArray_DIM(a[0], 0);
+    npy_intp s_pair[2] = {n, 2}, s_dh[2] = {n, 4}, s_lim[1] = {n}, s_T[3] = {-1, 4, 4}, s_q[2] = {-1, n};
+    if (!(a[1] = ik_array(o[1], NPY_DOUBLE, 2, s_pair, "pair")) || !(a[2] = ik_array(o[2], NPY_DOUBLE, 2, s_dh, "dh")) ||
+        !(a[3] = ik_array(o[3], NPY_DOUBLE, 1, s_lim, "lower")) || !(a[4] = ik_array(o[4], NPY_DOUBLE, 1, s_lim, "upper")) ||
+        !(a[6] = ik_array(o[6], NPY_DOUBLE, 3, s_T, "target")) || !(a[7] = ik_array(o[7], NPY_DOUBLE, 2, s_q, "seed"))) {
+        goto done;
+    }
+    npy_intp count = PyArray_DIM(a[7], 0), s_out[2] = {count, n};
+    if (PyArray_DIM(a[6], 0) != count && PyArray_DIM(a[6], 0) != 1) {
+        PyErr_SetString(PyExc_ValueError, "target: one pose, or one per seed");
+        goto done;
+    }
+    PyArrayObject *q = (PyArrayObject *)PyArray_SimpleNew(2, s_out, NPY_DOUBLE);
+    PyArrayObject *res = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_DOUBLE);
+    PyArrayObject *conv = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
+    if (!q || !res || !conv) {
+        Py_XDECREF(q); Py_XDECREF(res); Py_XDECREF(conv);
+        goto done;
+    }
+    apair_ik_chain ch = {(int)n, (const int *)PyArray_DATA(a[0]), PyArray_DATA(a[1]), PyArray_DATA(a[2]),
+                         PyArray_DATA(a[3]), PyArray_DATA(a[4]), scale};
+    int rc;
+    ptrdiff_t tstride = PyArray_DIM(a[6], 0) == 1 ? 0 : 16;
+    Py_BEGIN_ALLOW_THREADS
+    rc = apair_ik_local(&ch, (size_t)count, PyArray_DATA(a[6]), tstride, PyArray_DATA(a[7]), n, tol, max_iter,
+                        PyArray_DATA(q), PyArray_DATA(res), PyArray_DATA(conv));
+    Py_END_ALLOW_THREADS
+    if (rc) {
+        PyErr_SetString(PyExc_ValueError, "ik_local: the chain is not valid (kinds 0, 1 or 2; 1 to 6 joints)");
+        Py_DECREF(q); Py_DECREF(res); Py_DECREF(conv);
+        goto done;
+    }
+    result = Py_BuildValue("NNN", q, res, conv);
+done:
+    for (int i = 0; i < 8; i++) Py_XDECREF(a[i]);
+    return result;
+}
+
 static PyMethodDef native_methods[] = {
     {"call", (PyCFunction)(void (*)(void))native_call, METH_FASTCALL,
      "call(index, *inputs) -> list of outputs, or None if an input needs converting first."},
     {"names", native_names, METH_NOARGS, "names() -> the kernel names, in registry (index) order."},
     {"enable", native_enable, METH_O, "enable(flag): whether Chain.call may evaluate (the C backend is in use)."},
     {"kernel_address", native_kernel_address, METH_O, "kernel_address(index) -> address of the registry entry."},
+    {"ik_track", native_ik_track, METH_VARARGS,
+     "ik_track(kind, pair, dh, p0, p1, gamma, start) -> (end, status, steps, cond): apair_ik_track."},
+    {"ik_local", native_ik_local, METH_VARARGS,
+     "ik_local(kind, pair, dh, lower, upper, scale, target, seed, tol, max_iter) -> (q, residual, converged)."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -317,12 +317,15 @@ class AChain:
         |fk(q) − T| ≤ tol); (0, n) when T is out of reach. T: a 4×4 transform or a Study point.
         within_limits=True keeps only the solutions inside `limits` (no collisions).
 
-        Chains of 1 to 4 sinusoidal A-pairs or R-pairs, by kinematic mapping (see apair.ik): the
-        left half's constraint variety on the right part's image, eliminated to eigenvalue and
-        univariate problems. Angles in (−2π, 2π] for A-pairs, (−π, π] for R-pairs.
+        Chains of 1 to 6 sinusoidal A-pairs or R-pairs. n ≤ 4 by kinematic mapping (see apair.ik):
+        the left half's constraint variety on the right part's image, eliminated to eigenvalue and
+        univariate problems. n = 5, 6 by parameter homotopy (see apair.homotopy) from the design's
+        start system (`prepare_ik`, cached on disk), every complex solution tracked to T.
+        Angles in (−2π, 2π] for A-pairs, (−π, π] for R-pairs.
         full=True returns an `apair.ik.Solution`: q, error, candidates, complex_count, `inside`
         (whether each solution is within `limits`) and `certified` (False where the elimination
-        degenerated and a local search supplied the solutions: the set may be incomplete).
+        degenerated and a local search supplied the solutions, or, for n = 5, 6, the start set's
+        count was not reproduced or a path was lost: the set may be incomplete).
         """
         from .ik import Solver
 
@@ -335,6 +338,26 @@ class AChain:
             sol = dataclasses.replace(sol, q=sol.q[inside], error=sol.error[inside])
             inside = inside[inside]
         return dataclasses.replace(sol, inside=inside) if full else sol.q
+
+    def prepare_ik(self, progress=None, refresh: bool = False):
+        """n = 5, 6: the design's homotopy start system (every complex solution at a generic complex
+        pose, by monodromy), from the cache or computed now and cached (`apair ik-prepare`).
+        Returns `apair.homotopy.StartSystem` (.count, .certified, .runs, .loops, .seconds)."""
+        from . import homotopy
+
+        if self.n < 5:
+            raise ValueError(f"chain: start systems are for 5 and 6 joints (this chain has {self.n}; its ik is "
+                             "solved by elimination)")
+        return homotopy.start_system(homotopy.Problem.of(self), progress=progress, refresh=refresh)
+
+    def ik_local(self, T, q0, tol: float = 1e-10, max_iter: int = 100):
+        """The solution nearest (in the damped least-squares sense) to each seed: Levenberg-Marquardt
+        from q0 (n,) or (..., n) to T (4, 4) or (..., 4, 4), broadcast together, every step kept
+        inside `limits`; in C on the fk and Jacobian kernels. Returns `apair.ik.LocalSolution`
+        (q, residual = largest entry of |fk(q) − T|, converged = residual ≤ tol). Any n, any pairs."""
+        from .ik import ik_local
+
+        return ik_local(self, T, q0, tol=tol, max_iter=max_iter)
 
     def workspace(self, samples: int = 300_000, resolution: int = 24, rounds: int = 4, poses: bool = False,
                   engine=None, seed: int = 0, progress=None):

@@ -21,10 +21,46 @@ def _cmd_list(args) -> int:
 
 
 def _cmd_show(args) -> int:
+    if args.name == "ik_counts":
+        return _show_ik_counts(args)
     if args.json:
         print(json.dumps(polynomials.raw(args.name), indent=1))
     else:
         print(polynomials.text(args.name, "tex" if args.latex else "txt"), end="")
+    return 0
+
+
+def _show_ik_counts(args) -> int:
+    from . import ikcounts
+
+    rows = ikcounts.load()
+    if args.json:
+        print(json.dumps(rows, indent=1))
+        return 0
+    print("Generic number of complex inverse-kinematics solutions of R/A chains (A: sinusoidal A-pair,\n"
+          "R: R-pair; a pattern and its reverse have the same count). n < 6: at a pose of the chain's own\n"
+          "image. Computed by apair.ikcounts (make ik-counts) with the homotopy machinery of chain.ik.")
+    print(f"{'pattern':8s} {'count':>6s}  {'certified':9s}  how")
+    for r in rows:
+        print(f"{r['pattern']:8s} {r['count']:6d}  {'yes' if r['certified'] else 'no':9s}  {r['how']}")
+    return 0
+
+
+def _cmd_ik_prepare(args) -> int:
+    chain = load(args.file)
+    if chain.n < 5:
+        raise ValueError(f"{args.file}: {chain.n} joints; start systems are for 5 and 6 joints (fewer are solved "
+                         "by elimination, nothing to prepare)")
+    progress = None
+    if not args.quiet:
+        def progress(loops, count):
+            print(f"\rmonodromy: loop {loops:4d}, {count:6d} solutions", end="", file=sys.stderr, flush=True)
+    start = chain.prepare_ik(progress=progress, refresh=args.refresh)
+    if progress:
+        print(file=sys.stderr)
+    state = "certified" if start.certified else "NOT certified (the independent runs disagree)"
+    print(f"{chain.name}: start system of {start.count} complex solutions, {state}; runs found {start.runs} "
+          f"in {start.loops} loops ({start.seconds:.1f} s to compute; cached)")
     return 0
 
 
@@ -121,12 +157,11 @@ def _cmd_ik(args) -> int:
     with np.printoptions(precision=12, suppress=True, floatmode="maxprec"):
         if len(sol.q) == 0:
             dp, dr, q = distance(chain, T)
-            why = "" if sol.certified else (" (not certified: the exact elimination degenerated at this pose, "
-                                            "and the local search found no solution)")
+            why = "" if sol.certified else " (not certified complete)"
             print(f"{chain.name}: the pose is unreachable{why}. The nearest pose found inside the joint limits "
                   f"(q = {q} rad) is {dp:.3e} m and {dr:.3e} rad away.")
             return 1
-        complete = "" if sol.certified else "; found by the local fallback search, not certified complete"
+        complete = "" if sol.certified else "; not certified complete"
         count = f" of {sol.complex_count} complex" if sol.complex_count is not None else ""
         print(f"{chain.name}: {len(sol.q)} real solution(s){count}{complete}; angles in rad"
               f"{' and deg' if args.deg else ''}")
@@ -204,7 +239,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("list", help="list the derived polynomial sets")
     p.set_defaults(func=_cmd_list)
     p = sub.add_parser("show", help="print a derived polynomial set")
-    p.add_argument("name", help="a set from `apair list`, e.g. apair_motion")
+    p.add_argument("name", help="a set from `apair list`, e.g. apair_motion, or ik_counts (the inverse "
+                   "kinematics solution counts)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--latex", action="store_true", help="LaTeX instead of text")
     g.add_argument("--json", action="store_true", help="the machine-readable form")
@@ -221,11 +257,18 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--json", action="store_true", help="machine-readable")
     p.set_defaults(func=_cmd_variety)
     p = sub.add_parser("ik", help="all inverse kinematics solutions of a chain file at a pose")
-    p.add_argument("file", help="a chain TOML file (1 to 4 sinusoidal A-pairs or R-pairs)")
+    p.add_argument("file", help="a chain TOML file (1 to 6 sinusoidal A-pairs or R-pairs)")
     p.add_argument("pose", nargs="+", metavar="POSE",
                    help="a 4x4 transform row by row (16 numbers, or the top 12) or a Study point (8)")
     p.add_argument("--deg", action="store_true", help="also print the angles in degrees")
     p.set_defaults(func=_cmd_ik)
+    p = sub.add_parser("ik-prepare", help="the homotopy start system of a 5- or 6-joint chain file (cached)",
+                       description="Find every complex inverse-kinematics solution at a generic complex pose by "
+                       "monodromy and cache it under the design's content hash, so that `ik` need not.")
+    p.add_argument("file", help="a chain TOML file (5 or 6 sinusoidal A-pairs or R-pairs)")
+    p.add_argument("--refresh", action="store_true", help="compute it again even if it is cached")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.set_defaults(func=_cmd_ik_prepare)
     p = sub.add_parser("limits", help="joint ranges of a chain file: explicit, or the pairs' collision limits")
     p.add_argument("file", help="a chain TOML file")
     p.add_argument("--plot", metavar="PNG", help="plot the clearance of the first A-pair against theta")

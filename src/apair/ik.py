@@ -40,7 +40,10 @@ Every real candidate is checked with the chain's own fk kernel, refined by up to
 steps where it is not already accurate to 1e-3·tol, and kept only if fk(q) reproduces T to `tol`
 (largest entry of the 4×4 difference); duplicates are merged. Angles are returned in (−2π, 2π] for A-pairs
 (their motion has period 4π) and (−π, π] for R-pairs. General (non-sinusoidal) A-pairs have an
-elliptic, not rational, motion and are not supported; nor are chains of 5 or 6 joints.
+elliptic, not rational, motion and are not supported.
+
+Chains of 5 and 6 joints are solved by parameter homotopy (apair.homotopy), and `ik_local` is a
+Levenberg-Marquardt search from seeds in C for any chain.
 """
 from __future__ import annotations
 
@@ -260,8 +263,8 @@ class Solver:
 
     def __init__(self, chain, seed: int = SEED):
         n = chain.n
-        if n not in (1, 2, 3, 4):
-            raise ValueError(f"chain: inverse kinematics covers chains of 1 to 4 pairs, this one has {n}")
+        if n not in (1, 2, 3, 4, 5, 6):
+            raise ValueError(f"chain: inverse kinematics covers chains of 1 to 6 pairs, this one has {n}")
         for i, p in enumerate(chain.pairs):
             if p.kind == "general":
                 raise ValueError(f"pairs[{i}]: a general A-pair's motion is not rational; inverse kinematics "
@@ -270,6 +273,7 @@ class Solver:
         self.scale = _scale(chain)
         self.seed = seed
         self._eliminations = {}
+        self._homotopy = None  # n = 5, 6: (homotopy.Problem, its StartSystem)
 
     def _elimination(self, reverse: bool) -> "_Elimination":
         if reverse not in self._eliminations:
@@ -277,6 +281,8 @@ class Solver:
         return self._eliminations[reverse]
 
     def solve(self, T: np.ndarray, tol: float = 1e-9, count_complex: bool = False) -> Solution:
+        if self.chain.n >= 5:
+            return self._solve_homotopy(T, tol)
         target = _study(T)
         target[4:] /= self.scale
         Tm = _matrix(T)
@@ -304,6 +310,22 @@ class Solver:
                              "two R-pairs on one axis)")
         certified = len(q) == 0 and not degenerate  # the elimination's "none" stands
         return Solution(q, err, 0, None, certified=certified)
+
+
+    def _solve_homotopy(self, T, tol: float) -> Solution:
+        """n = 5, 6: every start solution tracked to T (apair.homotopy), real endpoints verified."""
+        from . import homotopy
+
+        Tm = _matrix(_study(T) if np.shape(T) == (8,) else _check_matrix(V.real_array("T", T)))
+        if self._homotopy is None:
+            problem = homotopy.Problem.of(self.chain)
+            self._homotopy = problem, homotopy.start_system(problem)
+        problem, start = self._homotopy
+        ends = homotopy.solve(problem, start, Tm)
+        q = homotopy.real_angles(problem, ends.theta)
+        q, err = _refine(self.chain, q, Tm, tol)
+        return Solution(q, err, len(homotopy.real_angles(problem, ends.theta)), len(ends.theta),
+                        certified=ends.complete)
 
 
 class _Elimination:
@@ -775,3 +797,55 @@ def distance(chain, T, starts: int = 64, seed: int = SEED) -> tuple[float, float
     dp = float(np.linalg.norm(F[:3, 3] - Tm[:3, 3]))
     c = (np.trace(F[:3, :3].T @ Tm[:3, :3]) - 1) / 2
     return dp, float(np.arccos(np.clip(c, -1.0, 1.0))), best
+
+
+# ----------------------------------------------------------------------------- the local solver
+@dataclass
+class LocalSolution:
+    """ik_local's result, one row per (pose, seed): q (..., n), the largest entry of |fk(q) − T|
+    and whether it is within tol."""
+
+    q: np.ndarray
+    residual: np.ndarray
+    converged: np.ndarray
+
+
+def ik_local(chain, T, q0, tol: float = 1e-10, max_iter: int = 100) -> LocalSolution:
+    """Levenberg-Marquardt from the seeds q0 (n,) or (..., n) to the poses T (4, 4) or (..., 4, 4)
+    (broadcast together), each step projected onto chain.limits, in C (apair_ik_local on the fk and
+    Jacobian kernels)."""
+    from . import kernels
+
+    native, why = kernels._native()
+    if native is None:
+        raise RuntimeError(f"ik_local needs the compiled C kernels: {why}")
+    T = V.real_array("T", T)
+    if T.shape[-2:] != (4, 4):
+        raise ValueError(f"T: expected a 4x4 transform or an array of them (..., 4, 4), got shape {T.shape}")
+    for M in T.reshape(-1, 4, 4):
+        _check_matrix(M)
+    q0 = chain._q(q0, "q0")
+    if not isinstance(max_iter, int) or isinstance(max_iter, bool) or max_iter < 1:
+        raise ValueError(f"max_iter: expected a positive integer, got {max_iter!r}")
+    tol = V.scalar("tol", tol, positive=True)
+    lim = chain.limits
+    outside = (q0 < lim[:, 0]) | (q0 > lim[:, 1])
+    if outside.any():
+        j = int(np.argwhere(outside)[0][-1])
+        raise ValueError(f"q0: joint {j + 1} lies outside chain.limits ({lim[j, 0]:.6g}, {lim[j, 1]:.6g}) rad")
+    try:
+        shape = np.broadcast_shapes(T.shape[:-2], q0.shape[:-1])
+    except ValueError:
+        raise ValueError(f"T, q0: batch shapes {T.shape[:-2]} and {q0.shape[:-1]} do not broadcast") from None
+    n = chain.n
+    Tb = np.ascontiguousarray(np.broadcast_to(T, shape + (4, 4)).reshape(-1, 4, 4))
+    qb = np.ascontiguousarray(np.broadcast_to(q0, shape + (n,)).reshape(-1, n))
+    kind = np.array([("revolute", "sinusoidal", "general").index(p.kind) for p in chain.pairs], np.int32)
+    pair = np.zeros((n, 2))
+    for i, p in enumerate(chain.pairs):
+        params = p.law_kernel[1]
+        pair[i, :len(params)] = params
+    q, res, conv = native.ik_local(kind, pair, np.ascontiguousarray(chain._dh, float),
+                                   np.ascontiguousarray(lim[:, 0]), np.ascontiguousarray(lim[:, 1]), _scale(chain),
+                                   Tb, qb, tol, max_iter)
+    return LocalSolution(q.reshape(shape + (n,)), res.reshape(shape), conv.reshape(shape).astype(bool))

@@ -1,0 +1,570 @@
+"""Every complex solution of an R/A chain's inverse kinematics by parameter homotopy (n = 1..6).
+
+The equations (derivations/chain_ik.py, kernels ik_system<n>) are F(θ; t, q) = 0: the chain's end
+frame at the pose with translation t and rotation quaternion q (up to scale), over the complex
+numbers. Paths are tracked in the complex angles θ (uniformly scaled, unlike exp(iθ)); a solution
+is identified by v_i = exp(iθ_i/2) for an A-pair and exp(iθ_i) for an R-pair, one point per pose
+(an A-pair's pose changes with θ + 2π, an R-pair's does not). The pose enters linearly, the
+solution set over all poses is irreducible, and monodromy reaches all of it:
+
+- **Start system** (per design, once): a random complex θ* and a pose p0 solving F(θ*; p0) = 0
+  give one solution; loops p0 → p_a → p_b → p0 through random complex poses carry every known
+  solution to a permutation of them and add the new ones, until `STABLE` loops in a row add none.
+  It is cached on disk under the design's content hash (`apair ik-prepare CHAIN.toml`, or the
+  first `ik`). A chain of n < 6 joints reaches only an n-dimensional family of poses; it is
+  tracked as a 6-joint chain, with 6 − n virtual R-pairs of random generic geometry appended
+  (`VIRTUAL`), at the target T·A_virtual(0): its solutions with the virtual joints at 0 are the
+  chain's solutions at T, and the others are discarded.
+- **Per pose**: the start solutions are tracked from p0 to the target with a random γ (path
+  p0 + s (p1 − p0), s = γτ/(1 + (γ − 1)τ)), in C (`apair_ik_track`: RK4 predictor, Newton
+  corrector, Newton refinement and a condition number at the end). Paths that fail, or land on the
+  same endpoint as another (a path jump), are tracked again with a new γ. Real endpoints are the
+  candidates; `apair.ik` verifies them with the fk kernel.
+- **Completeness**: a start set is `certified` when two independent monodromy runs (each from its
+  own random start, each stable for STABLE loops) found the same number, the union's; a pose's
+  answer is complete when, in addition, every path ended (finite and regular, or diverging to
+  infinity) and no two paths ended at one point. This is a strong numerical check, not a proof:
+  no trace test is run (see `ik_counts` for the counts it gives).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .study import from_matrix
+
+FORMAT = 1  # of the cached start systems
+STABLE = 20  # loops in a row without a new solution that end a monodromy run
+MAX_LOOPS = 400
+RETRIES = 4  # new gammas for the paths that failed or jumped
+SAME = 1e-4  # two endpoints whose angles differ by less than this are one solution
+VIRTUAL_ZERO = 1e-6  # |exp(iθ) − 1| under which a virtual joint is at 0
+REAL = 1e-5  # |Im θ| under which an endpoint is a real candidate (fk verifies it)
+OK, SINGULAR, FAILED, DIVERGED, TOO_LONG = range(5)
+
+
+# ----------------------------------------------------------------------------- the problem
+def scale_of(chain) -> float:
+    """The chain's length scale: its largest link length, offset or amplitude (at least 1 mm)."""
+    lengths = [abs(x) for x in (*chain.a, *chain.offset)] + [p.amplitude for p in chain.pairs]
+    return max(max(lengths), 1e-3)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """A chain's design as the tracker takes it (6 joints, the virtual ones last), lengths in units
+    of `scale`; `joints` is the chain's own n."""
+
+    kind: np.ndarray  # int32 (6,): 0 R-pair, 1 sinusoidal A-pair
+    pair: np.ndarray  # (6, 2): (h, 0)
+    dh: np.ndarray  # (6, 4)
+    scale: float
+    joints: int
+
+    @property
+    def n(self) -> int:
+        return len(self.kind)
+
+    @staticmethod
+    def of(chain) -> "Problem":
+        for i, p in enumerate(chain.pairs):
+            if p.kind == "general":
+                raise ValueError(f"pairs[{i}]: a general A-pair's motion is not rational; inverse kinematics "
+                                 "needs sinusoidal A-pairs or R-pairs")
+        s = scale_of(chain)
+        kind = [0 if p.kind == "revolute" else 1 for p in chain.pairs]
+        pair = [[p.amplitude / s, 0.0] for p in chain.pairs]
+        dh = [[a / s, al, c / s, ph] for a, al, c, ph in zip(chain.a, chain.alpha, chain.offset, chain.theta_offset)]
+        extra = 6 - chain.n
+        kind += [0] * extra
+        pair += [[0.0, 0.0]] * extra
+        dh += [list(row) for row in VIRTUAL[:extra]]
+        return Problem(np.array(kind, np.int32), np.array(pair, float), np.array(dh, float), s, chain.n)
+
+    def key(self) -> str:
+        """What the start system depends on, as text (floats exactly)."""
+        return json.dumps({"kind": self.kind.tolist(), "pair": [float(x).hex() for x in self.pair[:, 0]],
+                           "dh": [[float(x).hex() for x in row] for row in self.dh], "joints": self.joints})
+
+    def target(self, T: np.ndarray) -> np.ndarray:
+        """The pose (t, q) (7,) the 6 tracked joints must reach for the chain to reach T (4 × 4):
+        T in units of scale, times the virtual joints at 0."""
+        Ts = np.array(T, float)
+        Ts[:3, 3] /= self.scale
+        for a, alpha, c, phi in self.dh[self.joints:]:
+            Ts = Ts @ _dh(0.0, a, alpha, c, phi)
+        return np.concatenate([Ts[:3, 3], from_matrix(Ts)[:4]]).astype(complex)
+
+
+def _dh(theta, a, alpha, c, phi) -> np.ndarray:
+    """Rz(θ + φ)·Tz(c)·Tx(a)·Rx(α) (docs/conventions.md §3, an R-pair)."""
+    ct, st, ca, sa = math.cos(theta + phi), math.sin(theta + phi), math.cos(alpha), math.sin(alpha)
+    return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, c], [0, 0, 0, 1]])
+
+
+# The virtual joints that complete a chain of n < 6 joints (a, α, c, φ in units of the chain's
+# scale): fixed, of generic geometry (no zero, parallel or perpendicular axes), so that the start
+# systems and counts are reproducible.
+VIRTUAL = ((0.61, 1.13, 0.37, 0.0), (0.83, -0.71, 0.29, 0.0), (0.47, 1.37, -0.53, 0.0), (0.71, -1.21, 0.41, 0.0),
+           (0.53, 0.89, -0.31, 0.0))
+
+
+def _native():
+    """The compiled kernels' module, or None (the NumPy tracker is used then)."""
+    from . import kernels
+
+    return kernels._native()[0] if kernels.backend() == "c" else None
+
+
+def law(problem: Problem, theta: np.ndarray):
+    """(cos(θ/2), sin(θ/2), d, d') (…, n, 4) at complex angles θ (…, n), by the ik_law kernels."""
+    from . import kernels
+
+    v = np.exp(0.5j * np.asarray(theta))
+    out = np.empty(v.shape + (4,), complex)
+    for i, k in enumerate(problem.kind):
+        vi = np.stack([v[..., i].real, v[..., i].imag], -1)[..., None, :]
+        if k == 0:
+            (res,) = kernels.call("ik_law_revolute", vi)
+        else:
+            (res,) = kernels.call("ik_law_sinusoidal", vi, np.full(v.shape[:-1] + (1,), problem.pair[i, 0]))
+        out[..., i, :] = res[..., 0] + 1j * res[..., 1]
+    return out
+
+
+def _pairs(z: np.ndarray) -> np.ndarray:
+    return np.stack([z.real, z.imag], -1)
+
+
+def system(problem: Problem, theta: np.ndarray, target: np.ndarray, direction: np.ndarray):
+    """F (6,), dF/dθ (6, n) and dF/d(direction) (6,) at one point (the generated kernel)."""
+    from . import kernels
+
+    lw = law(problem, theta)
+    F, dF, dFs = kernels.call(f"ik_system{problem.n}", _pairs(lw), _pairs(target), _pairs(direction), problem.dh)
+    c = lambda a: a[..., 0] + 1j * a[..., 1]  # noqa: E731
+    return c(F), c(dF), c(dFs)
+
+
+def _linear_pose(problem: Problem, theta: np.ndarray):
+    """F(θ; p) = A p + b: (A (6, 7), b (6,)) at fixed θ (F is linear in the pose)."""
+    zero = np.zeros(7, complex)
+    b = system(problem, theta, zero, zero)[0]
+    A = np.stack([system(problem, theta, zero, e)[2] for e in np.eye(7, dtype=complex)], 1)
+    return A, b
+
+
+# ----------------------------------------------------------------------------- start systems
+@dataclass
+class StartSystem:
+    """The complete complex solution set at a generic complex pose p0 (see the module docstring)."""
+
+    problem_key: str
+    p0: np.ndarray  # (7,) complex
+    solutions: np.ndarray  # (k, n) complex
+    loops: int  # monodromy loops run
+    runs: list  # solution counts of the independent runs
+    certified: bool  # the count was stable and reproduced
+    seconds: float
+
+    @property
+    def count(self) -> int:
+        return len(self.solutions)
+
+    def save(self, path: Path) -> None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+        with open(tmp, "wb") as f:
+            np.savez(f, format=FORMAT, problem_key=self.problem_key, p0=self.p0, solutions=self.solutions, loops=self.loops, runs=np.array(self.runs),
+                     certified=self.certified, seconds=self.seconds)
+        os.replace(tmp, path)
+
+    @staticmethod
+    def load(path: Path, key: str) -> "StartSystem | None":
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                if int(z["format"]) != FORMAT or str(z["problem_key"]) != key:
+                    return None
+                return StartSystem(key, z["p0"], z["solutions"],
+                                   int(z["loops"]), [int(x) for x in z["runs"]], bool(z["certified"]),
+                                   float(z["seconds"]))
+        except (OSError, ValueError, KeyError):
+            return None
+
+
+def _distinct(sols: np.ndarray, known: np.ndarray | None = None) -> np.ndarray:
+    """Indices of the rows of sols (k, n) that differ from each other and from every row of known."""
+    keep = []
+    ref = [] if known is None else list(known)
+    for i, s in enumerate(sols):
+        if all(np.max(np.abs(s - r) / (1 + np.abs(r))) > SAME for r in ref):
+            keep.append(i)
+            ref.append(s)
+    return np.array(keep, int)
+
+
+def canonical(problem: Problem, theta: np.ndarray) -> np.ndarray:
+    """θ with its real part in (−π, π] (R-pair) or (−2π, 2π] (A-pair), the imaginary part kept."""
+    half = np.where(problem.kind == 0, np.pi, 2 * np.pi)
+    re = np.real(theta)
+    return (re - 2 * half * np.ceil((re - half) / (2 * half))) + 1j * np.imag(theta)
+
+
+class _Index:
+    """Solutions (complex angles) with a bucket index on Im θ_1, so that membership tests of
+    thousands of them are fast. Two solutions are one when their angles differ by at most SAME in
+    every joint, the real parts modulo the joint's period (one pose: 2π for an R-pair, 4π for an
+    A-pair)."""
+
+    def __init__(self, problem: Problem):
+        self.problem = problem
+        self.period = np.where(problem.kind == 0, 2 * np.pi, 4 * np.pi)
+        self.rows: list[np.ndarray] = []
+        self.buckets: dict = {}
+
+    def add(self, theta) -> bool:
+        """Adds θ unless it is already there; whether it was new."""
+        theta = canonical(self.problem, np.asarray(theta))
+        key = int(math.floor(theta[0].imag / (100 * SAME)))
+        for k in (key - 1, key, key + 1):
+            for j in self.buckets.get(k, ()):
+                d = theta - self.rows[j]
+                re = np.abs(d.real) % self.period
+                if np.all(np.maximum(np.minimum(re, self.period - re), np.abs(d.imag)) <= SAME):
+                    return False
+        self.buckets.setdefault(key, []).append(len(self.rows))
+        self.rows.append(theta)
+        return True
+
+
+def random_pose(rng: np.random.Generator) -> np.ndarray:
+    """A random complex pose (t, q), entries standard complex normal (the loops of monodromy need
+    poses well away from the real ones to permute the solutions)."""
+    return (rng.standard_normal(7) + 1j * rng.standard_normal(7)) / math.sqrt(2)
+
+
+def _unit_gamma(rng: np.random.Generator) -> complex:
+    """γ = exp(iφ), |φ| ≤ 1.2: the path's s(τ) is then an arc from 0 to 1 of bounded size (γ near
+    −1 would send it through infinity)."""
+    return complex(np.exp(1j * rng.uniform(-1.2, 1.2)))
+
+
+def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None = None):
+    """Every row of start (k, n) from p0 to p1: (end, status, steps, cond). engine: "c" (the
+    generated tracker apair_ik_track), "numpy" (track_numpy), or None: C where it is installed."""
+    start = np.ascontiguousarray(start, complex).reshape(-1, problem.n)
+    native = _native() if engine in (None, "c") else None
+    if native is None:
+        if engine == "c":
+            raise RuntimeError("engine: the compiled C kernels are not installed")
+        return track_numpy(problem, p0, p1, gamma, start)
+    return native.ik_track(problem.kind, problem.pair, problem.dh, np.ascontiguousarray(p0, complex),
+                           np.ascontiguousarray(p1, complex), complex(gamma), start)
+
+
+# The tracker's settings: those of apair_ik_default_options in generated/c/apair_ik.c.
+TRACK = {"initial_step": 0.05, "max_step": 0.25, "min_step": 1e-12, "max_steps": 500, "corrector_steps": 3,
+         "path_tol": 1e-7, "final_tol": 1e-14, "final_steps": 30, "divergence": 40.0, "singular_cond": 1e10}
+
+
+def _batched(problem: Problem, theta, s, p0, dp):
+    """H (k, 6), dH/dθ (k, 6, 6) and ∂H/∂s (k, 6) at the poses p0 + s dp (k,), by the NumPy or C
+    kernels (apair.kernels.call, batched)."""
+    from . import kernels
+
+    lw = law(problem, theta)
+    target = p0[None, :] + s[:, None] * dp[None, :]
+    F, dF, dFs = kernels.call(f"ik_system{problem.n}", _pairs(lw), _pairs(target),
+                              _pairs(np.broadcast_to(dp, target.shape)), problem.dh)
+    c = lambda a: a[..., 0] + 1j * a[..., 1]  # noqa: E731
+    return c(F), c(dF), c(dFs)
+
+
+def _solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """x with A x = b for stacked (k, n, n) and (k, n); NaN rows where A is singular."""
+    try:
+        return np.linalg.solve(A, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        out = np.full(b.shape, np.nan, complex)
+        for m in range(len(A)):
+            try:
+                out[m] = np.linalg.solve(A[m], b[m])
+            except np.linalg.LinAlgError:
+                pass
+        return out
+
+
+def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
+    """The tracker of apair_ik_track over NumPy, all paths at once (each with its own τ and step):
+    the same predictor (RK4), corrector (Newton, at most `corrector_steps`, each step at most half
+    the one before), step control and endpoint test. The fallback without the C kernels, and an
+    independent check of the C tracker."""
+    o = TRACK
+    p0, dp, g = np.asarray(p0, complex), np.asarray(p1, complex) - np.asarray(p0, complex), complex(gamma)
+    k = len(start)
+    v = np.array(start, complex)
+    tau, h = np.zeros(k), np.full(k, o["initial_step"])
+    good, steps = np.zeros(k, int), np.zeros(k, int)
+    status = np.full(k, -1)
+
+    def s_of(t):
+        den = 1 + (g - 1) * t
+        return g * t / den, g / den ** 2
+
+    def tangent(x, t):
+        s, ds = s_of(t)
+        _, J, Fs = _batched(problem, x, s, p0, dp)
+        return _solve(J, -(Fs * ds[:, None]))
+
+    def correct(x, t, iters, tol):
+        ok, prev, last = np.zeros(len(x), bool), np.full(len(x), np.inf), np.full(len(x), np.inf)
+        live = np.ones(len(x), bool)
+        s, _ = s_of(t)
+        for it in range(iters):
+            if not live.any():
+                break
+            F, J, _ = _batched(problem, x[live], s[live], p0, dp)
+            d = _solve(J, -F)
+            idx = np.flatnonzero(live)
+            x[idx] += d
+            dn = np.abs(d).max(1)
+            last[idx] = dn
+            conv = dn <= tol * (1 + np.abs(x[idx]).max(1))
+            ok[idx[conv]] = True
+            stall = (it > 0) & (dn > 0.5 * prev[idx]) & ~conv
+            far = np.abs(x[idx].imag).max(1)
+            ok[idx[stall & (far > 4.0) & (dn <= 1e3 * tol * (1 + np.abs(x[idx]).max(1)))]] = True
+            live[idx[conv | stall]] = False
+            prev[idx] = dn
+        return ok, last
+
+    with np.errstate(all="ignore"):
+        while True:
+            act = np.flatnonzero(status < 0)
+            act = act[tau[act] < 1.0]
+            if len(act) == 0:
+                break
+            steps[act] += 1
+            long = steps[act] > o["max_steps"]
+            status[act[long]] = TOO_LONG
+            act = act[~long]
+            hh = np.minimum(h[act], 1 - tau[act])
+            x, t = v[act], tau[act]
+            k1 = tangent(x, t)
+            k2 = tangent(x + 0.5 * hh[:, None] * k1, t + 0.5 * hh)
+            k3 = tangent(x + 0.5 * hh[:, None] * k2, t + 0.5 * hh)
+            k4 = tangent(x + hh[:, None] * k3, t + hh)
+            pred = x + hh[:, None] / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            ok, _ = correct(pred, t + hh, o["corrector_steps"], o["path_tol"])
+            ok &= np.all(np.isfinite(pred), axis=1)
+            acc, rej = act[ok], act[~ok]
+            v[acc] = pred[ok]
+            tau[acc] = np.where(hh[ok] == 1 - tau[acc], 1.0, tau[acc] + hh[ok])
+            good[acc] += 1
+            grow = good[acc] >= 2
+            h[acc[grow]] = np.minimum(2 * h[acc[grow]], o["max_step"])
+            good[acc[grow]] = 0
+            status[acc[np.abs(v[acc].imag).max(1) > o["divergence"]]] = DIVERGED
+            h[rej] *= 0.5
+            good[rej] = 0
+            status[rej[h[rej] < o["min_step"]]] = FAILED
+        cond = np.full(k, np.inf)
+        fin = np.flatnonzero(status < 0)
+        if len(fin):
+            x = v[fin]
+            prev = np.full(len(fin), np.inf)
+            for _ in range(o["final_steps"]):
+                y = x.copy()
+                _, d = correct(y, np.ones(len(fin)), 1, o["final_tol"])
+                better = np.isfinite(d) & (d < prev)
+                x[better], prev[better] = y[better], d[better]
+                if not better.any():
+                    break
+            v[fin] = x
+            s, _ = s_of(np.ones(len(fin)))
+            _, J, _ = _batched(problem, x, s, p0, dp)
+            cond[fin] = np.linalg.cond(J, 1)
+            conv = prev <= o["path_tol"] * (1 + np.abs(x).max(1))
+            out = ~np.all(np.isfinite(x), axis=1) | (np.abs(x.imag).max(1) > o["divergence"])
+            status[fin] = np.where(out, DIVERGED, np.where(conv & (cond[fin] <= o["singular_cond"]), OK, SINGULAR))
+    return v, status.astype(np.int32), steps.astype(np.int32), cond
+
+
+def _segment(problem: Problem, a, b, start: np.ndarray, rng, retries: int = 2):
+    """start tracked from pose a to b, the paths that failed again with a new γ (a path that fails
+    in a loop of monodromy would hide its solution's images)."""
+    end, status, _, _ = track(problem, a, b, _unit_gamma(rng), start)
+    for _ in range(retries):
+        bad = np.flatnonzero((status == FAILED) | (status == TOO_LONG))
+        if len(bad) == 0:
+            break
+        e, s, _, _ = track(problem, a, b, _unit_gamma(rng), start[bad])
+        end[bad], status[bad] = e, s
+    return end, status
+
+
+def _seed_solution(problem: Problem, rng):
+    """A random complex joint vector and a generic pose p0 at which it is a solution."""
+    n = problem.n
+    for _ in range(20):
+        theta = rng.uniform(-np.pi, np.pi, n) + 0.3j * rng.standard_normal(n)
+        A, b = _linear_pose(problem, theta)
+        # A p + b = 0: a particular solution plus a random element of the null space
+        M, rhs = A, -b
+        p, *_ = np.linalg.lstsq(M, rhs, rcond=None)
+        _, sv, Vh = np.linalg.svd(M)
+        null = Vh[len(sv[sv > 1e-10 * sv[0]]):].conj().T
+        p = p + null @ (rng.standard_normal(null.shape[1]) + 1j * rng.standard_normal(null.shape[1]))
+        F, J, _ = system(problem, theta, p, np.zeros(7, complex))
+        H, Hv = F, J
+        if np.max(np.abs(H)) > 1e-9 or np.abs(p[3:]).max() < 1e-3:
+            continue
+        sv = np.linalg.svd(Hv, compute_uv=False)
+        if sv[-1] < 1e-8 * sv[0]:
+            raise ValueError("chain: the inverse kinematics has no isolated solutions at a generic pose (the "
+                             "solutions form curves: e.g. two R-pairs on one axis, or a joint that cannot move the "
+                             "end frame)")
+        return theta, p
+    raise RuntimeError("homotopy: no regular starting solution found")
+
+
+def monodromy(problem: Problem, rng: np.random.Generator, stable: int = STABLE,
+              max_loops: int = MAX_LOOPS, progress=None, p0=None, known=None):
+    """All solutions at one generic pose by monodromy loops: (p0, solutions (k, n), loops)."""
+    index = _Index(problem)
+    if p0 is None:
+        theta, p0 = _seed_solution(problem, rng)
+        index.add(theta)
+    else:
+        for s in known:
+            index.add(s)
+    quiet, loops = 0, 0
+    while quiet < stable and loops < max_loops:
+        loops += 1
+        pa, pb = random_pose(rng), random_pose(rng)
+        cur = np.array(index.rows)
+        ok = np.ones(len(cur), bool)
+        for a, b in ((p0, pa), (pa, pb), (pb, p0)):
+            end, status = _segment(problem, a, b, cur, rng)
+            ok &= status == OK
+            cur = end
+        added = sum(index.add(s) for s in cur[ok])
+        quiet = 0 if added else quiet + 1
+        if progress:
+            progress(loops, len(index.rows))
+    return p0, np.array(index.rows), loops
+
+
+def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4) -> StartSystem:
+    """A start system: independent monodromy runs (each from its own random starting solution and
+    pose), merged at the pose of the larger set (the other's solutions tracked there; where the
+    union grows, monodromy continues from it). Certified once two runs found the union's count on their own;
+    at most `runs` runs."""
+    t0 = time.perf_counter()
+    rng = np.random.default_rng([seed, problem.n, problem.joints, 17])
+    p0, sols, loops = monodromy(problem, rng, progress=progress)
+    counts = [len(sols)]
+    while len(counts) < runs and sum(c == len(sols) for c in counts) < 2:
+        q0, other, more = monodromy(problem, rng, progress=progress)
+        loops += more
+        counts.append(len(other))
+        if len(other) > len(sols):  # merge into the larger set, at its pose
+            p0, sols, q0, other = q0, other, p0, sols
+        end, status = _segment(problem, q0, p0, other, rng)
+        index = _Index(problem)
+        for s in sols:
+            index.add(s)
+        if sum(index.add(s) for s in end[status == OK]):  # the union is larger: loop again from it
+            p0, sols, more = monodromy(problem, rng, progress=progress, p0=p0, known=index.rows)
+            loops += more
+    certified = sum(c == len(sols) for c in counts) >= 2
+    return StartSystem(problem.key(), p0, sols, loops, counts, certified, time.perf_counter() - t0)
+
+
+def _cache_path(problem: Problem) -> Path:
+    from .specialise import cache_root, toolkit_digest
+
+    own = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()  # this module decides the start set too
+    h = hashlib.sha256((problem.key() + "\0" + toolkit_digest() + f"\0{FORMAT}\0{own}").encode()).hexdigest()[:16]
+    return cache_root() / "ik" / f"{h}.npz"
+
+
+def start_system(problem: Problem, progress=None, refresh: bool = False) -> StartSystem:
+    """The design's start system from the cache, or prepared now and cached."""
+    path = _cache_path(problem)
+    if not refresh and path.exists():
+        got = StartSystem.load(path, problem.key())
+        if got is not None:
+            return got
+    start = prepare(problem, progress=progress)
+    try:
+        start.save(path)
+    except OSError:
+        pass  # a read-only cache: the start system is used without being kept
+    return start
+
+
+# ----------------------------------------------------------------------------- one pose
+@dataclass
+class Endpoints:
+    """The tracked solutions at one pose: finite endpoints θ (k, n) that satisfy all six
+    equations, whether the set is complete, and the path counts behind it."""
+
+    theta: np.ndarray
+    complete: bool
+    paths: int
+    failed: int
+    diverged: int
+
+
+def solve(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 0) -> Endpoints:
+    """Tracks the start system to the pose T (4 × 4, in the chain's units).
+
+    Every regular endpoint is a solution (Newton converged at it), so the endpoints of all
+    attempts are pooled; the paths that failed, or ended where another path had already ended (one
+    of them jumped), are tracked again with a new γ until as many distinct endpoints (plus paths to
+    infinity) as start solutions are found, or RETRIES attempts are spent."""
+    rng = np.random.default_rng([seed, 5])
+    p1 = problem.target(T)
+    found = _Index(problem)
+    todo = np.arange(start.count)
+    diverged = np.zeros(start.count, bool)
+    for _ in range(RETRIES + 1):
+        e, s, _, _ = track(problem, start.p0, p1, _unit_gamma(rng), start.solutions[todo])
+        again = []
+        for j, endpoint, st in zip(todo, e, s):
+            diverged[j] = st == DIVERGED
+            if st == OK:
+                if not found.add(endpoint):
+                    again.append(j)
+            elif st == SINGULAR:  # not refined to full accuracy (far out, or a multiple root): kept once
+                found.add(endpoint)
+            elif st != DIVERGED:
+                again.append(j)
+        if len(found.rows) + int(diverged.sum()) >= start.count or not again:
+            break
+        todo = np.array(again, int)
+    theta = np.array(found.rows).reshape(-1, problem.n)
+    if problem.joints < 6 and len(theta):  # the chain's own solutions: the virtual joints at 0
+        v = np.exp(1j * theta[:, problem.joints:])  # the virtual joints are R-pairs
+        theta = theta[np.all(np.abs(v - 1) <= VIRTUAL_ZERO, axis=1), :problem.joints]
+    accounted = len(found.rows) + int(diverged.sum())
+    complete = start.certified and accounted == start.count
+    return Endpoints(theta, complete, start.count, start.count - accounted, int(diverged.sum()))
+
+
+def real_angles(problem: Problem, theta: np.ndarray, tol: float = REAL) -> np.ndarray:
+    """The real endpoints' angles (m, n): (−π, π] for R-pairs, (−2π, 2π] for A-pairs."""
+    n = problem.joints
+    if len(theta) == 0:
+        return np.zeros((0, n))
+    real = np.all(np.abs(np.imag(theta)) <= tol, axis=1)
+    kind = Problem(problem.kind[:n], problem.pair[:n], problem.dh[:n], problem.scale, n)
+    return np.real(canonical(kind, theta[real]))

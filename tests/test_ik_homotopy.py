@@ -1,0 +1,250 @@
+"""Inverse kinematics of 5- and 6-joint chains by parameter homotopy (apair.homotopy), the local
+solver (AChain.ik_local) and the solution counts (apair.ikcounts): round trips on random and
+special designs, no false solutions, agreement with a dense multi-start search and with the
+eliminations of apair.ik, clear refusals."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import apair
+from apair import homotopy, ikcounts
+from apair.cli import main as cli
+
+
+def chain_of(pattern: str, rng, special: bool = False) -> apair.AChain:
+    """A chain of the pattern; special: twists of 0 and ±90°, zero lengths and offsets (a
+    PUMA-like arm: the last three axes meet in a spherical wrist)."""
+    n = len(pattern)
+    pairs = [apair.APair.revolute() if c == "R" else apair.APair(*rng.uniform(0.05, 0.12, 2)) for c in pattern]
+    if special:
+        alpha = np.array([np.pi / 2, 0.0, np.pi / 2, -np.pi / 2, np.pi / 2, 0.0])[:n]
+        a = np.array([0.0, 0.43, 0.02, 0.0, 0.0, 0.0])[:n]
+        c = np.array([0.0, 0.0, 0.15, 0.43, 0.0, 0.1])[:n]
+        return apair.AChain(pairs, a, alpha, c)
+    return apair.AChain(pairs, rng.uniform(0.1, 0.5, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.2, 0.2, n),
+                        rng.uniform(-1.0, 1.0, n))
+
+
+def periods(chain):
+    return np.array([2 * np.pi if p.kind == "revolute" else 4 * np.pi for p in chain.pairs])
+
+
+def contains(sols, q, per, tol=1e-7) -> bool:
+    d = np.abs((sols - q + per / 2) % per - per / 2)
+    return bool(len(sols)) and bool(np.any(np.all(d < tol, axis=1)))
+
+
+def test_derived_system_matches_the_dh_route():
+    """The homotopy system, its joint derivatives and its pose derivative against the 4×4 DH
+    product and complex central differences (mpmath) at a random complex point."""
+    from apair.derivations import chain_ik
+
+    assert chain_ik.check_system(2) < 1e-15
+
+
+def test_6r_has_16_solutions_and_round_trips():
+    rng = np.random.default_rng(1)
+    for _ in range(2):
+        chain = chain_of("RRRRRR", rng)
+        start = chain.prepare_ik()
+        assert start.count == 16 and start.certified
+        for q in rng.uniform(-np.pi, np.pi, (5, 6)):
+            T = chain.fk(q)
+            sol = chain.ik(T, full=True)
+            assert sol.certified and sol.complex_count == 16
+            assert contains(sol.q, q, periods(chain))
+            assert np.abs(chain.fk(sol.q) - T).max() <= 1e-9  # no false solution
+            assert len(sol.q) % 2 == 0  # real solutions of a real pose come in an even number (16 is even)
+
+
+@pytest.mark.parametrize("pattern", ["ARRRRR", "RRARRR", "RARRR", "RRRRA"])
+def test_mixed_chains_round_trip(pattern):
+    rng = np.random.default_rng(len(pattern) * 7 + pattern.index("A"))
+    chain = chain_of(pattern, rng)
+    start = chain.prepare_ik()
+    if len(pattern) == 6:
+        assert start.count == 48  # one A-pair and five R-pairs (the issue's monodromy count)
+    per = periods(chain)
+    for q in rng.uniform(-1, 1, (6, chain.n)) * per / 2:
+        T = chain.fk(q)
+        sol = chain.ik(T, full=True)
+        assert contains(sol.q, q, per), (q, sol.q)
+        assert np.abs(chain.fk(sol.q) - T).max() <= 1e-9
+
+
+def test_special_design_at_0_and_pi():
+    """A PUMA-like 6R (spherical wrist, twists of 0 and ±90°, zero lengths): its own start set,
+    and poses with joints at 0 and π."""
+    rng = np.random.default_rng(5)
+    chain = chain_of("RRRRRR", rng, special=True)
+    start = chain.prepare_ik()
+    assert start.count == 8  # a PUMA-type arm: 8 solutions (Pieper's decoupling)
+    qs = [np.array([0.3, -0.5, 0.4, 0.7, -0.6, 0.2]), np.array([0.0, 0.4, np.pi, 0.5, 0.6, 0.0]),
+          np.array([np.pi, 0.2, -0.3, 0.0, 1.2, np.pi])]
+    for q in qs:
+        T = chain.fk(q)
+        sol = chain.ik(T, full=True)
+        assert contains(sol.q, q, periods(chain), 1e-6), (q, sol.q)
+        assert np.abs(chain.fk(sol.q) - T).max() <= 1e-9
+
+
+def test_agrees_with_dense_multistart_search():
+    """Every solution a dense multi-start least-squares search finds (ik_local from 400 seeds over
+    the whole joint range) is among ik's, and ik finds no solution that does not reproduce T."""
+    rng = np.random.default_rng(11)
+    chain = chain_of("RRRRRR", rng)
+    for _ in range(2):
+        T = chain.fk(rng.uniform(-np.pi, np.pi, 6))
+        sols = chain.ik(T)
+        seeds = rng.uniform(-np.pi, np.pi, (400, 6))
+        loc = chain.ik_local(T, seeds, tol=1e-10, max_iter=200)
+        for q in loc.q[loc.converged]:
+            assert contains(sols, q, periods(chain), 1e-6), (q, sols)
+        assert loc.converged.sum() > 20
+
+
+def test_unreachable_poses_give_no_solution():
+    rng = np.random.default_rng(3)
+    for pattern in ("RRRRRR", "RARRR"):
+        chain = chain_of(pattern, rng)
+        T = np.eye(4)
+        T[:3, 3] = [10.0, 0.0, 0.0]  # beyond the reach
+        sol = chain.ik(T, full=True)
+        assert sol.q.shape == (0, chain.n)
+    chain = chain_of("RARRR", rng)  # a 5-joint chain off its 5-dimensional image
+    T = chain.fk(rng.uniform(-1, 1, 5))
+    T[:3, 3] += [0.01, -0.02, 0.015]
+    assert chain.ik(T).shape == (0, 5)
+
+
+def test_start_system_is_cached(tmp_path, monkeypatch):
+    monkeypatch.setenv("APAIR_CACHE", str(tmp_path))
+    chain = chain_of("RRRRRR", np.random.default_rng(2))
+    first = chain.prepare_ik()
+    files = list((tmp_path / "ik").glob("*.npz"))
+    assert len(files) == 1
+    again = chain.prepare_ik()
+    assert again.seconds == first.seconds and np.array_equal(again.solutions, first.solutions)
+    other = chain_of("RRRRRR", np.random.default_rng(3)).prepare_ik()
+    assert len(list((tmp_path / "ik").glob("*.npz"))) == 2 and other.count == 16
+
+
+def test_counts_agree_with_the_eliminations():
+    """For n ≤ 4 the stored counts (homotopy, virtual joints) equal the complex counts of the
+    independent eliminations of apair.ik at a random pose of a random design."""
+    rows = {r["pattern"]: r for r in ikcounts.load()}
+    rng = np.random.default_rng(0)
+    for pattern in ("R", "A", "RR", "AR", "RRR", "ARR", "RRRR", "ARRA"):
+        key = min(pattern, pattern[::-1])
+        chain = ikcounts.design(pattern)
+        sol = chain.ik(chain.fk(rng.uniform(-1, 1, len(pattern))), full=True)
+        assert rows[key]["count"] == sol.complex_count, pattern
+    assert rows["RRRRRR"]["count"] == 16 and rows["ARRRRR"]["count"] == 48
+
+
+def test_count_of_a_pattern_is_recomputed():
+    """The machinery behind the stored table, run again on small patterns."""
+    rows = {r["pattern"]: r for r in ikcounts.load()}
+    for pattern in ("RR", "RRRRRR"):
+        assert ikcounts.count(pattern)["count"] == rows[pattern]["count"]
+
+
+def test_ik_local_converges_within_limits_batched():
+    rng = np.random.default_rng(4)
+    chain = chain_of("ARRRRA", rng)
+    q = rng.uniform(-1, 1, (50, 6))
+    T = chain.fk(q)
+    res = chain.ik_local(T, q + rng.uniform(-0.3, 0.3, q.shape))
+    assert res.q.shape == (50, 6) and res.residual.shape == (50,) and res.converged.mean() > 0.95
+    ok = res.converged
+    assert np.abs(chain.fk(res.q[ok]) - T[ok]).max() <= 1e-10
+    # one pose, many seeds (broadcast), and the limits respected
+    lim = chain.limits
+    seeds = rng.uniform(lim[:, 0], lim[:, 1], (20, 6))
+    r2 = chain.ik_local(T[0], seeds)
+    assert r2.q.shape == (20, 6)
+    assert np.all((r2.q >= lim[:, 0]) & (r2.q <= lim[:, 1]))
+    # a general A-pair and n = 2: any chain
+    g = apair.AChain([apair.APair(0.05, 0.04, leg_length=0.068), apair.APair.revolute()], [0.2, 0.1], [0.5, 1.0])
+    qg = np.array([0.2, 0.3])
+    r3 = g.ik_local(g.fk(qg), qg + 0.05)
+    assert r3.residual <= 1e-10 and bool(r3.converged)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"T": np.full((4, 4), np.nan)}, r"T: contains NaN"),
+    ({"T": np.eye(3)}, r"T: expected a 4x4 transform"),
+    ({"q0": np.zeros(5)}, r"q0"),
+    ({"q0": np.full(6, 10.0)}, r"q0: joint 1 lies outside chain.limits"),
+    ({"max_iter": 0}, r"max_iter: expected a positive integer"),
+    ({"tol": -1.0}, r"tol"),
+])
+def test_ik_local_bad_input(kwargs, message):
+    chain = chain_of("RRRRRR", np.random.default_rng(0))
+    args = {"T": chain.fk(np.zeros(6)), "q0": np.zeros(6)}
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=message):
+        chain.ik_local(**args)
+
+
+def test_refusals():
+    rng = np.random.default_rng(6)
+    coaxial = apair.AChain([apair.APair.revolute()] * 6, [0.0, 0.3, 0.2, 0.1, 0.2, 0.1], [0.0, 1.0, 0.5, 1.2, 0.7, 0.4])
+    with pytest.raises(ValueError, match=r"not isolated|curves"):
+        coaxial.ik(coaxial.fk(np.full(6, 0.3)))
+    with pytest.raises(ValueError, match=r"start systems are for 5 and 6 joints"):
+        chain_of("RRRR", rng).prepare_ik()
+    general = apair.APair(0.05, 0.04, leg_length=0.068)
+    g = apair.AChain([general] + [apair.APair.revolute()] * 5, [0.2] * 6, [1.0] * 6)
+    with pytest.raises(ValueError, match=r"pairs\[0\]: a general A-pair"):
+        g.ik(np.eye(4))
+
+
+def test_cli(tmp_path, capsys):
+    path = tmp_path / "arm.toml"
+    joints = "\n".join(f"[[joint]]\npair = \"revolute\"\na = {a}\nalpha_deg = {al}\noffset = {c}\n"
+                       for a, al, c in [(0.1, 90, 0.3), (0.4, 10, 0.0), (0.05, 80, 0.02), (0.0, -70, 0.4),
+                                        (0.02, 60, 0.0), (0.0, 20, 0.1)])
+    path.write_text(f"name = \"arm\"\n{joints}")
+    assert cli(["ik-prepare", str(path), "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "start system of 16 complex solutions, certified" in out
+    assert cli(["show", "ik_counts"]) == 0
+    out = capsys.readouterr().out
+    assert "RRRRRR" in out and " 16 " in out
+    assert cli(["ik-prepare", str(tmp_path / "missing.toml")]) == 2
+
+
+def test_numpy_tracker_agrees_with_the_c_tracker():
+    """The same paths by apair_ik_track (C) and track_numpy (the fallback): the same endpoints."""
+    chain = chain_of("RRARRR", np.random.default_rng(8))
+    problem = homotopy.Problem.of(chain)
+    start = chain.prepare_ik()
+    T = chain.fk(np.array([0.3, -0.2, 0.5, 1.0, -0.7, 0.4]))
+    p1 = problem.target(T)
+    ends = {}
+    for engine in ("c", "numpy"):
+        end, status, _, _ = homotopy.track(problem, start.p0, p1, np.exp(0.4j), start.solutions[:12], engine=engine)
+        ends[engine] = (end, status)
+    (ec, sc), (en, sn) = ends["c"], ends["numpy"]
+    both = (sc == homotopy.OK) & (sn == homotopy.OK)
+    assert both.sum() >= 10
+    d = np.abs(homotopy.canonical(problem, ec[both]) - homotopy.canonical(problem, en[both])).max()
+    assert d < 1e-8
+
+
+def test_ik_without_the_c_kernels():
+    """With the NumPy backend, n = 6 is solved by the NumPy tracker (slower, the same answer)."""
+    from apair import kernels
+
+    chain = chain_of("RRRRRR", np.random.default_rng(9))
+    q = np.array([0.4, -0.3, 0.9, -1.2, 0.5, 2.0])
+    T = chain.fk(q)
+    want = chain.ik(T)
+    kernels.set_backend("numpy")
+    try:
+        got = apair.AChain(chain.pairs, chain.a, chain.alpha, chain.offset, chain.theta_offset).ik(T)
+    finally:
+        kernels.set_backend(None)
+    assert got.shape == want.shape and np.abs(got - want).max() < 1e-9
