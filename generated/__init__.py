@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: ac70234fc7598465
+Content hash: c640f436824a301d
 """

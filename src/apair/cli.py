@@ -39,7 +39,9 @@ def _show_ik_counts(args) -> int:
         return 0
     print("Generic number of complex inverse-kinematics solutions of R/A chains (A: sinusoidal A-pair,\n"
           "R: R-pair; a pattern and its reverse have the same count). n < 6: at a pose of the chain's own\n"
-          "image. Computed by apair.ikcounts (make ik-counts) with the homotopy machinery of chain.ik.")
+          "image. Computed by apair.ikcounts (make ik-counts) with the homotopy machinery of chain.ik;\n"
+          "'how' lists the start set's monodromy runs (for n < 6 the 6-joint set with virtual joints);\n"
+          "certified: two runs found the count (a numerical check, not a proof).")
     print(f"{'pattern':8s} {'count':>6s}  {'certified':9s}  how")
     for r in rows:
         print(f"{r['pattern']:8s} {r['count']:6d}  {'yes' if r['certified'] else 'no':9s}  {r['how']}")

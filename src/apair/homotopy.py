@@ -1,30 +1,32 @@
 """Every complex solution of an R/A chain's inverse kinematics by parameter homotopy (n = 1..6).
 
-The equations (derivations/chain_ik.py, kernels ik_system<n>) are F(θ; t, q) = 0: the chain's end
+The equations (derivations/chain_ik.py, kernel ik_system6) are F(θ; t, q) = 0: the chain's end
 frame at the pose with translation t and rotation quaternion q (up to scale), over the complex
-numbers. Paths are tracked in the complex angles θ (uniformly scaled, unlike exp(iθ)); a solution
-is identified by v_i = exp(iθ_i/2) for an A-pair and exp(iθ_i) for an R-pair, one point per pose
-(an A-pair's pose changes with θ + 2π, an R-pair's does not). The pose enters linearly, the
-solution set over all poses is irreducible, and monodromy reaches all of it:
+numbers. Paths are tracked in the complex angles θ. Two angle vectors are one solution when they
+differ by a period in each joint: 4π for an A-pair (its pose changes with θ + 2π), 2π for an
+R-pair. The pose enters linearly, the solution set over all poses is irreducible, and monodromy
+reaches all of it:
 
 - **Start system** (per design, once): a random complex θ* and a pose p0 solving F(θ*; p0) = 0
   give one solution; loops p0 → p_a → p_b → p0 through random complex poses carry every known
   solution to a permutation of them and add the new ones, until `STABLE` loops in a row add none.
   It is cached on disk under the design's content hash (`apair ik-prepare CHAIN.toml`, or the
   first `ik`). A chain of n < 6 joints reaches only an n-dimensional family of poses; it is
-  tracked as a 6-joint chain, with 6 − n virtual R-pairs of random generic geometry appended
+  tracked as a 6-joint chain, with 6 − n fixed virtual R-pairs of generic geometry appended
   (`VIRTUAL`), at the target T·A_virtual(0): its solutions with the virtual joints at 0 are the
   chain's solutions at T, and the others are discarded.
 - **Per pose**: the start solutions are tracked from p0 to the target with a random γ (path
   p0 + s (p1 − p0), s = γτ/(1 + (γ − 1)τ)), in C (`apair_ik_track`: RK4 predictor, Newton
-  corrector, Newton refinement and a condition number at the end). Paths that fail, or land on the
-  same endpoint as another (a path jump), are tracked again with a new γ. Real endpoints are the
-  candidates; `apair.ik` verifies them with the fk kernel.
+  corrector, Newton refinement and a condition number at the end), or by `track_numpy` without
+  the C kernels. Paths that fail, or land on the same endpoint as another (a path jump), are
+  tracked again with a new γ. Real endpoints are the candidates; `apair.ik` verifies them with
+  the fk kernel.
 - **Completeness**: a start set is `certified` when two independent monodromy runs (each from its
-  own random start, each stable for STABLE loops) found the same number, the union's; a pose's
-  answer is complete when, in addition, every path ended (finite and regular, or diverging to
-  infinity) and no two paths ended at one point. This is a strong numerical check, not a proof:
-  no trace test is run (see `ik_counts` for the counts it gives).
+  own random start, each stable for STABLE loops) found the same number, the union's, and
+  CHECK_LOOPS further loops carry every solution without losing a path; a pose's
+  answer is complete when, in addition, every path ended (finite, or diverging to infinity) at a
+  distinct point. This is a numerical check, not a proof: no trace test is run, and a solution
+  that every run misses (one far out in the complex, where paths lose digits) goes unnoticed.
 """
 from __future__ import annotations
 
@@ -43,6 +45,7 @@ from .study import from_matrix
 FORMAT = 1  # of the cached start systems
 STABLE = 20  # loops in a row without a new solution that end a monodromy run
 MAX_LOOPS = 400
+CHECK_LOOPS = 3  # loops after the runs in which no path may be lost for a certified start set
 RETRIES = 4  # new gammas for the paths that failed or jumped
 SAME = 1e-4  # two endpoints whose angles differ by less than this are one solution
 VIRTUAL_ZERO = 1e-6  # |exp(iθ) − 1| under which a virtual joint is at 0
@@ -465,8 +468,8 @@ def monodromy(problem: Problem, rng: np.random.Generator, stable: int = STABLE,
 def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4) -> StartSystem:
     """A start system: independent monodromy runs (each from its own random starting solution and
     pose), merged at the pose of the larger set (the other's solutions tracked there; where the
-    union grows, monodromy continues from it). Certified once two runs found the union's count on their own;
-    at most `runs` runs."""
+    union grows, monodromy continues from it), at most `runs`; certified when two runs found the
+    union's count on their own and CHECK_LOOPS more loops lose no path."""
     t0 = time.perf_counter()
     rng = np.random.default_rng([seed, problem.n, problem.joints, 17])
     p0, sols, loops = monodromy(problem, rng, progress=progress)
@@ -484,7 +487,16 @@ def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4) -> St
         if sum(index.add(s) for s in end[status == OK]):  # the union is larger: loop again from it
             p0, sols, more = monodromy(problem, rng, progress=progress, p0=p0, known=index.rows)
             loops += more
-    certified = sum(c == len(sols) for c in counts) >= 2
+    # every solution is carried around CHECK_LOOPS more loops: a path that cannot be tracked (far out
+    # in the complex, where digits are lost) marks a set whose missing members could hide there
+    lost = 0
+    for _ in range(CHECK_LOOPS):
+        pa, pb = random_pose(rng), random_pose(rng)
+        cur = sols
+        for a, b in ((p0, pa), (pa, pb), (pb, p0)):
+            cur, status = _segment(problem, a, b, cur, rng)
+            lost += int(np.sum((status == FAILED) | (status == TOO_LONG)))
+    certified = sum(c == len(sols) for c in counts) >= 2 and lost == 0
     return StartSystem(problem.key(), p0, sols, loops, counts, certified, time.perf_counter() - t0)
 
 

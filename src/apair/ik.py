@@ -55,6 +55,7 @@ import numpy as np
 import scipy.linalg
 
 from . import _validate as V
+from .homotopy import scale_of
 from .study import _qmul, conjugate, from_matrix, multiply, normalise, to_matrix
 
 SEED = 46  # fixed: the parameter shifts and random combinations are reproducible
@@ -131,10 +132,7 @@ def _quartic() -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------- chain constants
-def _scale(chain) -> float:
-    """The chain's length scale: its largest link length, offset or amplitude (at least 1 mm)."""
-    lengths = [abs(x) for x in (*chain.a, *chain.offset)] + [p.amplitude for p in chain.pairs]
-    return max(max(lengths), 1e-3)
+_scale = scale_of  # the chain's length scale (apair.homotopy.scale_of)
 
 
 def _periods(chain) -> np.ndarray:
