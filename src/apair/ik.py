@@ -309,7 +309,6 @@ class Solver:
         certified = len(q) == 0 and not degenerate  # the elimination's "none" stands
         return Solution(q, err, 0, None, certified=certified)
 
-
     def _solve_homotopy(self, T, tol: float) -> Solution:
         """n = 5, 6: every start solution tracked to T (apair.homotopy), real endpoints verified."""
         from . import homotopy
@@ -320,10 +319,9 @@ class Solver:
             self._homotopy = problem, homotopy.start_system(problem)
         problem, start = self._homotopy
         ends = homotopy.solve(problem, start, Tm)
-        q = homotopy.real_angles(problem, ends.theta)
-        q, err = _refine(self.chain, q, Tm, tol)
-        return Solution(q, err, len(homotopy.real_angles(problem, ends.theta)), len(ends.theta),
-                        certified=ends.complete)
+        real = homotopy.real_angles(problem, ends.theta)
+        q, err = _refine(self.chain, real, Tm, tol)
+        return Solution(q, err, len(real), len(ends.theta), certified=ends.complete)
 
 
 class _Elimination:
