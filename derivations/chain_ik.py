@@ -336,7 +336,7 @@ def check_system(n: int = 3, digits: int = 30) -> float:
 
 
 def derive():
-    """The law kernels in the tracking variables and ik_system6 (a shorter chain is tracked with
+    """The law kernels at exp(iθ/2) and ik_system6 (a shorter chain is tracked with
     virtual joints added, see apair.homotopy), after the independent check on n = 1 and 3."""
     checks = {n: check_system(n) for n in (1, 3)}
     specs = [law_spec("revolute"), law_spec("sinusoidal"), system_spec(MAX_N)]
