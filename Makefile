@@ -8,7 +8,7 @@ DEPS_STAMP := $(VENV)/.deps-stamp
 CFLAGS_STRICT := -std=c99 -Wall -Wextra -Werror -pedantic -O2
 CHECK_DIR := build/check-generated
 
-.PHONY: all venv generate install varieties lib examples demo check test bench clean ik-counts
+.PHONY: all venv generate install varieties lib examples demo check test bench clean ik-counts browser pictures
 
 all: generate install varieties lib examples demo
 
@@ -67,8 +67,21 @@ check: install
 	diff -r $(EXAMPLE_CODE) $(CHECK_DIR)-example || \
 	  (echo "$(EXAMPLE_CODE) is out of date: run make examples and commit" >&2; exit 1)
 
-test: install lib check
+test: install lib check browser
 	$(PY) -m pytest -q
+
+# The viewer's test drives Debian's Chromium (Playwright, from the test extra, launches it):
+# installed here from the system packages when it is missing.
+CHROMIUM := /usr/bin/chromium
+browser: $(CHROMIUM)
+$(CHROMIUM):
+	@echo "installing Chromium (Debian package chromium) for the browser test"
+	@if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq --no-install-recommends chromium
+
+# The README's pictures of the MuJoCo model and the viewer (off-screen OpenGL by EGL, Chromium).
+pictures: install browser
+	$(PY) docs/pictures.py
 
 # Timings (never asserted by tests): results in bench/results.json. The peers (the bench extra of
 # pyproject.toml) are installed here only; builds of the C/C++ peers are kept in build/bench.

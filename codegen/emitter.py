@@ -20,7 +20,7 @@ import jinja2
 import sympy as sp
 
 from . import derivation
-from .printers import CPrinter, NumpyPrinter
+from .printers import CPrinter, JSPrinter, NumpyPrinter
 from .polynomials import render_polynomial_set
 
 _spec = derivation("spec")
@@ -104,6 +104,7 @@ class Lowered:
     fingerprint: str
     hoisted: Hoisted | None  # None: nothing depends on design inputs alone
     calls: list[LoweredCall]  # kernels evaluated first (their own hoisting applies)
+    js: Code | None = None  # for WEB_KERNELS only
 
     @property
     def name(self) -> str:
@@ -111,6 +112,10 @@ class Lowered:
 
 
 PRINTERS = {"c": CPrinter(), "py": NumpyPrinter()}
+# The kernels the browser viewer (apair view) evaluates, printed as JavaScript too: the pair laws,
+# one joint's transform (the page multiplies them into every frame) and the leg end points.
+WEB_KERNELS = ("law_revolute", "law_sinusoidal", "law_general", "fk1", "pair_legs")
+JS = JSPrinter()
 
 
 def _bare(a: Arg) -> Arg:
@@ -229,7 +234,12 @@ def lower(spec: KernelSpec) -> Lowered:
             if a.design and name is None:
                 raise ValueError(f"{spec.name}: {c.kernel.name}'s design input {a.name} cannot be zeros")
     hoisted = _hoist(spec, local, assignments, reduced, printed["c"])
-    return Lowered(signature, inputs, code["c"], code["py"], ops, spec.fingerprint(), hoisted, calls)
+    js = None
+    if spec.name in WEB_KERNELS:
+        if spec.calls:
+            raise ValueError(f"{spec.name}: a web kernel cannot call other kernels")
+        js = Code([(str(s), JS.doprint(e)) for s, e in assignments], [(_bare(a), [JS.doprint(e) for e in es]) for a, es in outs])
+    return Lowered(signature, inputs, code["c"], code["py"], ops, spec.fingerprint(), hoisted, calls, js)
 
 
 def _ordered(replacements, steps):
@@ -346,6 +356,12 @@ class Emitter:
                     "ops_per_item": _ops_per_item(k, by_name),
                     "fingerprint": fingerprints[k.name][:16],
                 }
+        web = sorted((k for k in all_kernels if k.js is not None), key=lambda k: k.name)
+        if sorted(k.name for k in web) == sorted(WEB_KERNELS):  # (not all derivations run: --only)
+            js_t, js_src = self._template("kernels.js.j2")
+            files["js/apair_kernels.js"] = js_t.render(
+                kernels=web, sources=sorted({k.spec.source for k in web}),
+                hash=content_hash([js_src] + [fingerprints[k.name] for k in web]))
         files["numpy/__init__.py"] = self.env.get_template("numpy_init.py.j2").render(
             modules=sorted(lowered), kernels=sorted((k.name, stem) for stem, ks in lowered.items() for k in ks),
             hash=header_hash)

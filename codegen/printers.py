@@ -1,8 +1,9 @@
-"""Expression printers for the two targets: C99 (libm) and NumPy."""
+"""Expression printers for the targets: C99 (libm), NumPy, and JavaScript (the browser viewer's kernels)."""
 from __future__ import annotations
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
+from sympy.printing.jscode import JavascriptCodePrinter
 from sympy.printing.numpy import NumPyPrinter
 
 
@@ -30,13 +31,9 @@ def _float(expr) -> str:
     return repr(float(expr))
 
 
-class CPrinter(C99CodePrinter):
-    """C99 without M_PI and friends (not in strict C99): constants print as decimal literals."""
-
-    _sqrt_name = "sqrt"
-
-    def __init__(self):
-        super().__init__({"math_macros": {}})
+class _Literals:
+    """What the C and JavaScript printers share: π and e as 25-digit decimals, floats as their
+    shortest exact literal, small powers as products."""
 
     def _print_NumberSymbol(self, expr):
         return sp.Float(expr.evalf(25), 25).__str__()
@@ -51,6 +48,15 @@ class CPrinter(C99CodePrinter):
         return _small_power(self, expr) or super()._print_Pow(expr)
 
 
+class CPrinter(_Literals, C99CodePrinter):
+    """C99 without M_PI and friends (not in strict C99): constants print as decimal literals."""
+
+    _sqrt_name = "sqrt"
+
+    def __init__(self):
+        super().__init__({"math_macros": {}})
+
+
 class NumpyPrinter(NumPyPrinter):
     _sqrt_name = "numpy.sqrt"
 
@@ -62,3 +68,12 @@ class NumpyPrinter(NumPyPrinter):
 
     def _print_Pow(self, expr, rational=False):
         return _small_power(self, expr) or super()._print_Pow(expr, rational=rational)
+
+
+class JSPrinter(_Literals, JavascriptCodePrinter):
+    """JavaScript (ES5 Math), with the C printer's literals; rationals as quotients of doubles."""
+
+    _sqrt_name = "Math.sqrt"
+
+    def _print_Rational(self, expr):
+        return f"({int(expr.p)}.0/{int(expr.q)}.0)"

@@ -283,6 +283,31 @@ class AChain:
 
         return SpecialisedChain(self, kernels)
 
+    def to_mjcf(self, q=None, path=None, overwrite: bool = False, collisions: bool = False) -> str:
+        """The MuJoCo model (MJCF) of the mechanism, every A-pair as its Griffis-Duffy platform with
+        six legs closed by equality constraints (apair.mjcf); keyframe 0 is q (default: all zero).
+        Written to `path` too if given (an existing file only with overwrite=True). Returns the XML."""
+        from . import mjcf
+
+        xml = mjcf.to_mjcf(self, q, name=getattr(self, "name", None) or "apair chain", collisions=collisions)
+        if path is not None:
+            from .plots import write_text
+
+            write_text(path, xml, overwrite, ".xml")
+        return xml
+
+    def to_html(self, path=None, overwrite: bool = False, workspace: int = 0) -> str:
+        """The interactive 3D viewer of the chain as one offline HTML page (apair.view); written to
+        `path` too if given (an existing file only with overwrite=True). Returns the HTML."""
+        from . import view
+
+        html = view.to_html(self, workspace)
+        if path is not None:
+            from .plots import write_text
+
+            write_text(path, html, overwrite, ".html")
+        return html
+
     def simulate(self, q0, qd0, t, tau=None, rtol=1e-10, atol=1e-12, method="DOP853", limits="stop"):
         """Integrate the equations of motion from (q0, qd0) and report the state at times `t`.
 

@@ -210,6 +210,31 @@ def _cmd_workspace(args) -> int:
     return 0
 
 
+def _cmd_export(args) -> int:
+    chain = load(args.file)
+    q = None if args.q is None else _parse_angles(args.q.split(","), args.deg)
+    from . import mjcf
+    from .plots import write_text
+
+    xml = mjcf.to_mjcf(chain, q, name=chain.name or os.path.basename(args.file), collisions=args.collisions)
+    out = write_text(args.out, xml, args.force, ".xml")
+    legs = sum(6 for p in chain.pairs if p.kind != "revolute")
+    print(f"{chain.name}: MuJoCo model written to {out} ({chain.n} pairs, {legs} legs closed by "
+          f"{legs} connect constraints; keyframe 0 at q = {np.round(q if q is not None else np.zeros(chain.n), 6).tolist()})")
+    return 0
+
+
+def _cmd_view(args) -> int:
+    from . import view
+
+    chain = load(args.file)
+    if args.workspace < 0:
+        raise ValueError(f"--workspace: expected a number of samples >= 0, got {args.workspace}")
+    out = view.write(chain, args.out, overwrite=args.force, workspace=args.workspace)
+    print(f"{chain.name}: viewer written to {out} (open it in a browser; it needs no network)")
+    return 0
+
+
 def _cmd_kernels(args) -> int:
     for name, k in sorted(manifest()["kernels"].items()):
         ins = ", ".join(f"{a['name']}{tuple(a['shape'])}" for a in k["inputs"])
@@ -296,6 +321,26 @@ def build_parser() -> argparse.ArgumentParser:
                    help="comma-separated subset of fk, fk_study, jacobian, mass_matrix, coriolis, gravity_torques, "
                    "bias, inverse_dynamics, forward_dynamics, energy (default: all)")
     p.set_defaults(func=_cmd_codegen)
+    p = sub.add_parser("export", help="the chain in another tool's format: mjcf (a MuJoCo model)",
+                       description="Write a MuJoCo model (MJCF) of the chain's mechanism: every A-pair as its "
+                       "Griffis-Duffy platform, legs as bodies closed by equality constraints, motors on the pair axes.")
+    p.add_argument("format", choices=["mjcf"], help="the format (mjcf: MuJoCo XML)")
+    p.add_argument("file", help="a chain TOML file")
+    p.add_argument("out", help="the file to write (.xml)")
+    p.add_argument("--q", metavar="Q1,Q2,...", help="the configuration of keyframe 0 (radians unless --deg; default 0)")
+    p.add_argument("--deg", action="store_true", help="--q in degrees")
+    p.add_argument("--collisions", action="store_true", help="let plates and legs collide (off by default)")
+    p.add_argument("--force", action="store_true", help="replace an existing file")
+    p.set_defaults(func=_cmd_export)
+    p = sub.add_parser("view", help="an interactive 3D view of a chain file: one offline HTML page",
+                       description="Write one self-contained HTML page: the mechanism in 3D (plates, legs, links, "
+                       "frames), a slider per joint within the chain's limits, the end-effector pose and each "
+                       "pair's clearance, computed in the page by the generated JavaScript kernels.")
+    p.add_argument("file", help="a chain TOML file")
+    p.add_argument("--out", default="view.html", metavar="HTML", help="the page to write (default view.html)")
+    p.add_argument("--workspace", type=int, default=0, metavar="N", help="also N sampled end-effector points")
+    p.add_argument("--force", action="store_true", help="replace an existing file")
+    p.set_defaults(func=_cmd_view)
     p = sub.add_parser("kernels", help="list the generated kernels with their operation counts")
     p.set_defaults(func=_cmd_kernels)
     p = sub.add_parser("demo", help="print the derived A-pair law and, given a chain file, one pose")

@@ -36,9 +36,11 @@ def _native():
     except ImportError as exc:
         return None, f"the compiled C kernels (apair._native) are not installed ({exc})"
     m = manifest()
-    if module.content_hash != m["content_hash"] or getattr(module, "sources_hash", None) != m["sources_hash"]:
-        return None, (f"the compiled C kernels (apair._native, {module.content_hash}) were built from other "
-                      f"generated C sources than the manifest's ({m['content_hash']}): reinstall apair")
+    built = (module.content_hash, getattr(module, "sources_hash", None))
+    if built != (m["content_hash"], m["sources_hash"]):
+        return None, (f"the compiled C kernels (apair._native, content {built[0]}, sources {built[1]}) were built "
+                      f"from other generated C sources than the manifest's (content {m['content_hash']}, sources "
+                      f"{m['sources_hash']}): reinstall apair")
     return module, None
 
 

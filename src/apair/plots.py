@@ -35,6 +35,18 @@ def _target(path, overwrite: bool, suffix: str = ".png") -> Path:
     return p
 
 
+def write_text(path, text: str, overwrite: bool, suffix: str) -> Path:
+    """Text (a MuJoCo model, a viewer page) to path by the rules of the pictures: `suffix` added
+    where the name has none; an existing file only with overwrite=True."""
+    p = _target(path, overwrite, suffix)
+
+    def save(tmp):
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(text)
+
+    return _write(p, overwrite, save)
+
+
 def _write(p: Path, overwrite: bool, save) -> Path:
     """save(tmp) writes the picture to a new file beside p, which then becomes p: copied into a
     file created exclusively (what appeared in between is never replaced), or, with overwrite,

@@ -1,0 +1,85 @@
+"""`apair view`: one self-contained HTML page (works offline) that draws the chain in 3D with a
+slider per joint.
+
+The page's kinematics are the generated JavaScript kernels (generated/js/apair_kernels.js, from
+the derivations like the C and NumPy kernels): each joint's law, its transform fk1 (multiplied
+into every frame), and pair_legs for the legs. Nothing in the page retypes a formula. The legs'
+clearance (collisions.clearances: segment distances) is a table in θ, 0.25° apart, read by linear
+interpolation. The drawing is a small canvas renderer (no library, nothing fetched).
+"""
+from __future__ import annotations
+
+import json
+from html import escape
+from importlib import resources
+
+import numpy as np
+
+from . import collisions
+
+CLEARANCE_STEP = np.radians(0.25)  # the clearance table's spacing in θ
+
+
+def _kernels_js() -> str:
+    return resources.files("apair.generated").joinpath("js/apair_kernels.js").read_text(encoding="utf-8")
+
+
+def _page_template() -> str:
+    return resources.files("apair").joinpath("data/view.html").read_text(encoding="utf-8")
+
+
+def _clearance_table(pair, lo: float, hi: float) -> dict:
+    th = np.arange(lo, hi + CLEARANCE_STEP / 2, CLEARANCE_STEP)
+    th = th[th <= hi]
+    legs, plates = collisions.clearances(pair, th)
+    return {"theta0": float(th[0]), "step": float(CLEARANCE_STEP), "legs": np.min(legs, axis=-1).tolist(),
+            "plates": np.asarray(plates).tolist()}
+
+
+def chain_data(chain, workspace: int = 0, seed: int = 0) -> dict:
+    """What the page needs of the chain: its joints (law kernel and parameters, DH row, range),
+    the A-pairs' radii and clearance tables, and optionally `workspace` sampled end points."""
+    lim = np.array(chain.limits, float)
+    joints = []
+    for i, p in enumerate(chain.pairs):
+        kernel, params = p.law_kernel
+        lo, hi = lim[i]
+        period = 2 * np.pi if p.kind == "revolute" else 4 * np.pi
+        lo, hi = (max(lo, -period / 2), min(hi, period / 2))
+        j = {"kind": p.kind, "law": kernel, "params": [float(x) for x in params],
+             "dh": [float(chain.a[i]), float(chain.alpha[i]), float(chain.offset[i]), float(chain.theta_offset[i])],
+             "lower": float(lo), "upper": float(hi)}
+        if p.kind != "revolute":
+            j["radii"] = [float(p.base_radius), float(p.platform_radius)]
+            j["leg_radius"] = float(p.leg_radius)
+            j["clearance"] = _clearance_table(p, lo, hi)
+        joints.append(j)
+    data = {"name": getattr(chain, "name", None) or "apair chain", "n": chain.n, "joints": joints}
+    if workspace:
+        rng = np.random.default_rng(seed)
+        q = rng.uniform([j["lower"] for j in joints], [j["upper"] for j in joints], (workspace, chain.n))
+        data["workspace"] = np.round(chain.fk(q)[:, :3, 3], 6).ravel().tolist()
+    scale = max(1e-3, float(np.abs(chain.a).sum() + np.abs(chain.offset).sum()
+                            + sum(p.amplitude or 0.0 for p in chain.pairs if p.kind != "revolute")))
+    data["scale"] = scale
+    return data
+
+
+def to_html(chain, workspace: int = 0) -> str:
+    """The viewer page of the chain (see the module's docstring)."""
+    if not isinstance(workspace, (int, np.integer)) or isinstance(workspace, bool) or workspace < 0:
+        raise ValueError(f"workspace: expected a number of samples >= 0, got {workspace!r}")
+    data = json.dumps(chain_data(chain, int(workspace)), separators=(",", ":"))
+    page = _page_template()
+    title = getattr(chain, "name", None) or "apair chain"
+    return (page.replace("/*APAIR_KERNELS*/", _kernels_js())
+                .replace("/*APAIR_CHAIN*/null", data.replace("</", "<\\/"))
+                .replace("APAIR_TITLE", escape(title)))
+
+
+def write(chain, path, overwrite: bool = False, workspace: int = 0):
+    """Writes the page to path (.html added if it has no suffix); an existing file only with
+    overwrite=True. Returns the path."""
+    from .plots import write_text
+
+    return write_text(path, to_html(chain, workspace), overwrite, ".html")
