@@ -179,6 +179,8 @@ def test_ik_local_converges_within_limits_batched():
     ({"q0": np.full(6, 10.0)}, r"q0: joint 1 lies outside chain.limits"),
     ({"max_iter": 0}, r"max_iter: expected a positive integer"),
     ({"tol": -1.0}, r"tol"),
+    ({"T": np.stack([np.eye(4)] * 3 + [np.diag([1.0, 1.0, -1.0, 1.0])])}, r"not a proper rotation"),
+    ({"T": np.stack([np.eye(4), np.eye(4) + np.eye(4, k=-3) * 0.5])}, r"T: last row must be \[0, 0, 0, 1\], got \[0.5"),
 ])
 def test_ik_local_bad_input(kwargs, message):
     chain = chain_of("RRRRRR", np.random.default_rng(0))

@@ -230,3 +230,22 @@ def test_point_mass_link_and_flat_legs():
         assert abs(qacc[hinge_dofs(m, chain)][0] - ref[0]) <= 1e-6 * abs(ref[0])
     with pytest.raises(ValueError, match="d = 0"):
         mjcf.state(chain, [np.pi])
+
+
+def test_revolute_arm_needs_no_loops():
+    """A 6R arm (PUMA-like: twists ±90°, zero lengths) has no equality constraints, so MuJoCo's
+    own qacc is exact: it equals forward_dynamics to rounding, which checks the links' inertials."""
+    pairs = [apair.APair.revolute() for _ in range(6)]
+    links = [apair.Link(1.0 + 0.1 * i, [0.01 * i, 0.0, 0.05], np.diag([0.01, 0.012, 0.005])) for i in range(6)]
+    chain = apair.AChain(pairs, a=[0, 0.43, 0.02, 0, 0, 0], alpha=[np.pi / 2, 0, -np.pi / 2, np.pi / 2, -np.pi / 2, 0],
+                         offset=[0, 0, 0.15, 0.43, 0, 0.05], theta_offset=[0, 0.2, 0, 0, 0, np.pi], links=links)
+    m, d = model(chain)
+    assert m.neq == 0 and m.nq == 6
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        q, qd, tau = rng.uniform(-3, 3, 6), rng.uniform(-1, 1, 6), rng.uniform(-2, 2, 6)
+        d.qpos[:], d.qvel[:] = mjcf.state(chain, q, qd)
+        d.ctrl[:] = tau
+        mujoco.mj_forward(m, d)
+        ref = chain.forward_dynamics(q, qd, tau)
+        assert np.abs(d.qacc - ref).max() <= 1e-10 * np.abs(ref).max()

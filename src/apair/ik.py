@@ -655,10 +655,15 @@ def _study(T) -> np.ndarray:
 
 
 def _check_matrix(T: np.ndarray) -> np.ndarray:
-    R = T[:3, :3]
-    if not np.allclose(T[3], [0, 0, 0, 1], atol=1e-12):
-        raise ValueError(f"T: last row must be [0, 0, 0, 1], got {T[3].tolist()}")
-    if np.abs(R.T @ R - np.eye(3)).max() > 1e-9 or np.linalg.det(R) < 0:
+    """T (4, 4) or a stack (..., 4, 4) of rigid transforms, checked at once: last row [0, 0, 0, 1],
+    rotation part orthonormal with det +1."""
+    rows = T[..., 3, :].reshape(-1, 4)
+    bad = np.flatnonzero(~np.all(np.isclose(rows, [0, 0, 0, 1], atol=1e-12), axis=1))
+    if len(bad):
+        raise ValueError(f"T: last row must be [0, 0, 0, 1], got {rows[bad[0]].tolist()}")
+    R = T[..., :3, :3]
+    ortho = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1))
+    if np.any(~(ortho <= 1e-9)) or np.any(np.linalg.det(R) < 0):
         raise ValueError("T: the rotation part is not a proper rotation (orthonormal, det +1)")
     return T
 
@@ -818,8 +823,7 @@ def ik_local(chain, T, q0, tol: float = 1e-10, max_iter: int = 100) -> LocalSolu
     T = V.real_array("T", T)
     if T.shape[-2:] != (4, 4):
         raise ValueError(f"T: expected a 4x4 transform or an array of them (..., 4, 4), got shape {T.shape}")
-    for M in T.reshape(-1, 4, 4):
-        _check_matrix(M)
+    _check_matrix(T)
     q0 = chain._q(q0, "q0")
     if not isinstance(max_iter, int) or isinstance(max_iter, bool) or max_iter < 1:
         raise ValueError(f"max_iter: expected a positive integer, got {max_iter!r}")
