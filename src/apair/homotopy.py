@@ -46,7 +46,7 @@ FORMAT = 1  # of the cached start systems
 STABLE = 20  # loops in a row without a new solution that end a monodromy run
 MAX_LOOPS = 400
 CHECK_LOOPS = 3  # loops after the runs in which no path may be lost for a certified start set
-RETRIES = 4  # new gammas for the paths that failed or jumped
+RETRIES = 10  # new gammas for the paths that failed or jumped (rare poses need many)
 SAME = 1e-4  # two endpoints whose angles differ by less than this are one solution
 VIRTUAL_ZERO = 1e-6  # |exp(iθ) − 1| under which a virtual joint is at 0
 REAL = 1e-5  # |Im θ| under which an endpoint is a real candidate (fk verifies it)
@@ -234,6 +234,10 @@ class _Index:
 
     def add(self, theta) -> bool:
         """Adds θ unless it is already there; whether it was new."""
+        return self.place(theta)[0]
+
+    def place(self, theta) -> tuple[bool, int]:
+        """Adds θ unless it is already there: (whether it was new, its row)."""
         theta = canonical(self.problem, np.asarray(theta))
         key = int(math.floor(theta[0].imag / (100 * SAME)))
         for k in (key - 1, key, key + 1):
@@ -241,10 +245,10 @@ class _Index:
                 d = theta - self.rows[j]
                 re = np.abs(d.real) % self.period
                 if np.all(np.maximum(np.minimum(re, self.period - re), np.abs(d.imag)) <= SAME):
-                    return False
+                    return False, j
         self.buckets.setdefault(key, []).append(len(self.rows))
         self.rows.append(theta)
-        return True
+        return True, len(self.rows) - 1
 
 
 def random_pose(rng: np.random.Generator) -> np.ndarray:
@@ -540,29 +544,32 @@ def solve(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 0) ->
     """Tracks the start system to the pose T (4 × 4, in the chain's units).
 
     Every regular endpoint is a solution (Newton converged at it), so the endpoints of all
-    attempts are pooled; the paths that failed, or ended where another path had already ended (one
-    of them jumped), are tracked again with a new γ until as many distinct endpoints (plus paths to
-    infinity) as start solutions are found, or RETRIES attempts are spent."""
+    attempts are pooled. The paths that failed are tracked again with a new γ, and so are both
+    paths that ended at one endpoint: either may have jumped, and the one that did has lost its
+    own endpoint. This goes on until as many distinct endpoints (plus paths to infinity) as start
+    solutions are found, or RETRIES attempts are spent."""
     rng = np.random.default_rng([seed, 5])
     p1 = problem.target(T)
     found = _Index(problem)
+    owner: dict[int, int] = {}  # endpoint row -> the path that found it first
     todo = np.arange(start.count)
     diverged = np.zeros(start.count, bool)
     for _ in range(RETRIES + 1):
         e, s, _, _ = track(problem, start.p0, p1, _unit_gamma(rng), start.solutions[todo])
-        again = []
+        again = {}
         for j, endpoint, st in zip(todo, e, s):
             diverged[j] = st == DIVERGED
-            if st == OK:
-                if not found.add(endpoint):
-                    again.append(j)
-            elif st == SINGULAR:  # not refined to full accuracy (far out, or a multiple root): kept once
-                found.add(endpoint)
+            if st in (OK, SINGULAR):  # SINGULAR: not refined to full accuracy (far out, a multiple root)
+                new, row = found.place(endpoint)
+                if new:
+                    owner[row] = int(j)
+                elif st == OK and owner[row] != j:
+                    again[int(j)] = again[owner[row]] = True
             elif st != DIVERGED:
-                again.append(j)
+                again[int(j)] = True
         if len(found.rows) + int(diverged.sum()) >= start.count or not again:
             break
-        todo = np.array(again, int)
+        todo = np.array(sorted(again), int)
     theta = np.array(found.rows).reshape(-1, problem.n)
     if problem.joints < 6 and len(theta):  # the chain's own solutions: the virtual joints at 0
         v = np.exp(1j * theta[:, problem.joints:])  # the virtual joints are R-pairs
