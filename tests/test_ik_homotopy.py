@@ -314,3 +314,28 @@ def test_c_api_of_the_solvers_under_sanitizers(tmp_path):
     assert build.returncode == 0, build.stderr
     run = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, run.stdout + run.stderr
+
+
+def test_a_path_that_jumped_is_tracked_again():
+    """A 1A5R design and pose where, at the first γ, the path to the real solution jumped onto
+    another path's endpoint (so it came out regular, and only the other path was retried, which then
+    met that endpoint): both paths of a shared endpoint must be tracked again, and the round trip
+    found (this pose was missed by the bench before)."""
+    pairs = [apair.APair(0.0894522450069962, 0.08317438085810323)] + [apair.APair.revolute()] * 5
+    chain = apair.AChain(
+        pairs,
+        [0.263635203177209, 0.18895241699896512, 0.4816851661181739, 0.10775141501509339, 0.191913467375736,
+         0.14151345832805196],
+        [-0.3218506212560599, 1.05104389114957, -0.5148268530667165, 0.38861836889957235, 0.46808403937365384,
+         1.1772035292198306],
+        [-0.0818416888849614, -0.021256176303189822, -0.024558618496665297, -0.08726532048028118,
+         0.16744413665010577, -0.11806065323127078],
+        [0.6871820774332562, 0.07303753391445089, 0.9248489585971429, -0.2783536752238869, -0.36779126683054164,
+         0.40316882447018854])
+    q = np.array([-0.5749977310747729, 1.0259281067603379, 1.790164090382775, 2.106829768361326,
+                  -3.0893720644103655, 0.8085360585797985])
+    sol = chain.ik(chain.fk(q), full=True)
+    per = np.array([4 * np.pi] + [2 * np.pi] * 5)
+    d = np.abs((sol.q - q + per / 2) % per - per / 2)
+    assert np.any(np.all(d < 1e-7, axis=1)), sol
+    assert sol.complex_count == 48 and sol.certified
