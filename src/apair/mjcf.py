@@ -32,6 +32,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from . import _validate as V
+from .kernels import call
 
 MASSLESS = 1e-9  # mass given to a massless moving body, relative to the model's mass scale
 FLAT = 1e-9  # d below this × the pair's size: the legs are flat (d = 0), refused by `state`
@@ -60,11 +61,6 @@ def _rz(t: float) -> np.ndarray:
     return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
 
 
-def _rx(t: float) -> np.ndarray:
-    c, s = math.cos(t), math.sin(t)
-    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
-
-
 def _arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The smallest rotation taking the unit vector u to the unit vector v."""
     w = np.cross(u, v)
@@ -79,9 +75,11 @@ def _arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 
 def _link_offset(chain, i: int) -> tuple[np.ndarray, np.ndarray]:
-    """(R, p) of frame i in pair i's platform frame: Rz(φ_i) Tz(c_i) Tx(a_i) Rx(α_i)."""
-    Rz = _rz(chain.theta_offset[i])
-    return Rz @ _rx(chain.alpha[i]), Rz @ np.array([chain.a[i], 0.0, 0.0]) + np.array([0, 0, chain.offset[i]])
+    """(R, p) of frame i in pair i's platform frame, Rz(φ_i) Tz(c_i) Tx(a_i) Rx(α_i): the joint
+    transform kernel fk1 at θ = 0, d = 0."""
+    law = call("law_revolute", [0.0])[0]
+    T = call("fk1", law[None, :], chain._dh[i][None, :])[0]
+    return T[:3, :3], T[:3, 3]
 
 
 def _legs(pair, theta: float):
