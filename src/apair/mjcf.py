@@ -56,11 +56,6 @@ def _quat(R: np.ndarray) -> np.ndarray:
     return q if q[0] >= 0 else -q
 
 
-def _rz(t: float) -> np.ndarray:
-    c, s = math.cos(t), math.sin(t)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
-
-
 def _arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The smallest rotation taking the unit vector u to the unit vector v."""
     w = np.cross(u, v)
@@ -82,13 +77,14 @@ def _link_offset(chain, i: int) -> tuple[np.ndarray, np.ndarray]:
     return T[:3, :3], T[:3, 3]
 
 
-def _legs(pair, theta: float):
-    """Base points (6, 3) in the pair's base frame, platform points (6, 3) in its platform frame
-    and the platform points in the base frame, at θ."""
-    pts = pair.leg_endpoints(theta)
-    d = pair.translation(theta)
-    local = (pts[:, 1] - [0, 0, d]) @ _rz(theta)  # Rz(θ)ᵀ p, row-wise
-    return pts[:, 0], local, pts[:, 1]
+def _reference_legs(pair):
+    """The legs at θ = 0 (the model's reference), in the pair's base frame: base points (6, 3),
+    lengths (6,), and each leg body's reference frame (6, 3, 3), z along the leg."""
+    pts = pair.leg_endpoints(0.0)
+    axis = pts[:, 1] - pts[:, 0]
+    length = np.linalg.norm(axis, axis=1)
+    frames = np.stack([_arc(np.array([0, 0, 1.0]), u) for u in axis / length[:, None]])
+    return pts[:, 0], length, frames
 
 
 def _check_q(chain, q) -> np.ndarray:
@@ -118,14 +114,13 @@ def state(chain, q, qd=None) -> tuple[np.ndarray, np.ndarray]:
         if not (d > FLAT * max(pair.base_radius, pair.platform_radius) and np.isfinite(dd)):
             raise ValueError(f"q: pair {i + 1} is at d = 0 (legs flat, q[{i}] = {q[i]!r}), where the loops leave "
                              "the legs' positions and rates undetermined")
-        base, _, ref_top = _legs(pair, 0.0)
-        _, _, top = _legs(pair, q[i])
+        base, length, frames = _reference_legs(pair)
+        top = pair.leg_endpoints(q[i])[:, 1]
         for k in range(6):
-            u0 = (ref_top[k] - base[k]) / np.linalg.norm(ref_top[k] - base[k])
             L = np.linalg.norm(top[k] - base[k])
             u = (top[k] - base[k]) / L
-            R0 = _arc(np.array([0, 0, 1.0]), u0)  # the leg body's reference frame in the base frame
-            R = _arc(u0, u) @ R0
+            R0 = frames[k]  # the leg body's reference frame in the base frame
+            R = _arc(R0[:, 2], u) @ R0
             qpos.extend(_quat(R0.T @ R))
             # the platform point's velocity relative to the base, and the leg's rate (⊥ to its axis)
             v = qd[i] * np.cross([0, 0, 1.0], top[k]) + np.array([0, 0, dd * qd[i]])
@@ -196,15 +191,14 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
         h0 = 0.0
         if pair.kind != "revolute":
             h0 = pair.translation(0.0)
-            base, local, ref_top = _legs(pair, 0.0)
+            base, length, frames = _reference_legs(pair)
             # the base plate (in frame i−1) and the legs
             out.append(f'{indent}<body name="pair{n1}_base_plate" pos="{_f(p_prev)}" quat="{_f(quat_prev)}">')
             plate(indent + "  ", f"pair{n1}_base_plate", pair.base_radius, 0.0, 0.0, pair.thickness or None)
             out.append(f"{indent}</body>")
             for k in range(6):
-                u0 = (ref_top[k] - base[k]) / np.linalg.norm(ref_top[k] - base[k])
-                L = float(np.linalg.norm(ref_top[k] - base[k]))  # the leg's length (constant)
-                R0 = R_prev @ _arc(np.array([0, 0, 1.0]), u0)
+                L = float(length[k])
+                R0 = R_prev @ frames[k]
                 m = pair.leg_mass
                 It = m * L * L / 12
                 Is = 0.5 * m * pair.leg_radius ** 2 if pair.leg_radius > 0 else SPIN * It
@@ -253,9 +247,7 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
         motors.append(f'    <motor name="pair{n1}_motor" joint="pair{n1}_theta" gear="1"/>')
         if pair.kind == "revolute":
             continue
-        base, local, ref_top = _legs(pair, 0.0)
-        for k in range(6):
-            L = float(np.linalg.norm(ref_top[k] - base[k]))
+        for k, L in enumerate(_reference_legs(pair)[1]):
             eq.append(f'    <connect name="pair{n1}_loop{k + 1}" body1="pair{n1}_leg{k + 1}" body2="link{n1}" '
                       f'anchor="0 0 {_f(L)}"/>')
     g = chain.gravity
