@@ -59,9 +59,6 @@ def chain_data(chain, workspace: int = 0, seed: int = 0) -> dict:
         rng = np.random.default_rng(seed)
         q = rng.uniform([j["lower"] for j in joints], [j["upper"] for j in joints], (workspace, chain.n))
         data["workspace"] = np.round(chain.fk(q)[:, :3, 3], 6).ravel().tolist()
-    scale = max(1e-3, float(np.abs(chain.a).sum() + np.abs(chain.offset).sum()
-                            + sum(p.amplitude or 0.0 for p in chain.pairs if p.kind != "revolute")))
-    data["scale"] = scale
     return data
 
 
