@@ -442,7 +442,7 @@ def time_ik6(pattern: str, poses: int, rng) -> dict:
             t0 = time.perf_counter()
             chain.ik(chain.fk(qs[0]))  # the first call loads the start system from the cache
             first = time.perf_counter() - t0
-            times, found, certified = [], 0, 0
+            times, found, certified, methods = [], 0, 0, {}
             for q in qs:
                 T = chain.fk(q)
                 t0 = time.perf_counter()
@@ -452,6 +452,7 @@ def time_ik6(pattern: str, poses: int, rng) -> dict:
                 d = np.abs((sol.q - q + per / 2) % per - per / 2)
                 found += bool(len(sol.q)) and bool(np.any(np.all(d < 1e-7, axis=1)))
                 certified += sol.certified
+                methods[sol.method] = methods.get(sol.method, 0) + 1
         finally:
             if old is None:
                 os.environ.pop("APAIR_CACHE", None)
@@ -460,7 +461,7 @@ def time_ik6(pattern: str, poses: int, rng) -> dict:
     ms = np.array(times) * 1e3
     return {"pattern": pattern, "poses": poses, "median_ms": float(np.median(ms)), "max_ms": float(ms.max()),
             "prepare_s": prep, "first_call_ms": first * 1e3, "start_count": start.count, "start_certified": start.certified,
-            "round_trips_found": found, "certified_poses": certified}
+            "round_trips_found": found, "certified_poses": certified, "methods": methods}
 
 
 def time_ik_local(rng, count: int = 2000) -> dict:
@@ -604,7 +605,8 @@ def main(argv=None) -> int:
               f"{r['solutions_per_pose']:.1f} solutions)")
     for p, r in results["ik6"].items():
         print(f"  6-joint {p:24s} median {r['median_ms']:.2f} ms, worst {r['max_ms']:.2f} ms over {r['poses']} poses "
-              f"({r['round_trips_found']} round trips found, {r['certified_poses']} certified); start system "
+              f"({r['round_trips_found']} round trips found, {r['certified_poses']} certified; "
+              + ", ".join(f"{k} {v}" for k, v in sorted(r["methods"].items())) + "); start system "
               f"{r['start_count']} solutions ({'certified' if r['start_certified'] else 'not certified'}) prepared "
               f"in {r['prepare_s']:.1f} s")
     r = results["ik_local"]

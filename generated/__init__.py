@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: c640f436824a301d
+Content hash: 48663cdb47501530
 """

@@ -250,11 +250,26 @@ def test_forward_and_reversed_eliminations_agree():
             except ik._Degenerate:
                 break
             real = [c for c in cands if np.all(np.abs(np.imag(c)) <= ik.CAND_TOL * (1 + np.abs(c)))]
-            counts.append(len(ik._refine(chain, solver._elimination(reverse).angles(real), T, 1e-9)[0]))
+            q_all = ik._with_twins(chain, solver._elimination(reverse).angles(real))
+            counts.append(len(ik._refine(chain, q_all, T, 1e-9)[0]))
         if len(counts) == 2 and min(counts) > 0:
             assert counts[0] == counts[1], (chain, q)
             compared += 1
     assert compared >= 20
+
+
+def test_both_preimages_of_an_a_pair_at_pi():
+    """A sinusoidal pair's pose curve crosses itself at θ = ±π (one pose, two joint values): with
+    the pair in the right half, whose pose the elimination solves for, both must come back."""
+    rng = np.random.default_rng(77)
+    for _ in range(14):  # the 14th draw of test_forward_and_reversed_eliminations_agree
+        chain, q = special_chain(rng, 4), special_angles(rng, 4)
+    assert chain.pairs[2].kind != "revolute" and abs(q[2]) == np.pi
+    sols = chain.ik(chain.fk(q))
+    twin = q.copy()
+    twin[2] = -q[2]
+    for target in (q, twin):
+        assert np.any(np.all(np.abs(sols - target) < 1e-7, axis=1)), (target, sols)
 
 
 @pytest.mark.parametrize("n", [2, 4])

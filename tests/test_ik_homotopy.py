@@ -236,6 +236,24 @@ def test_numpy_tracker_agrees_with_the_c_tracker():
     assert np.all(d < 1e-6) and np.median(d) < 1e-10  # one solution each (the worst conditioned to ~1e-7)
 
 
+def test_threads_track_the_same_paths(monkeypatch):
+    """The paths shared among threads end where one thread takes them (bit for bit: each path is
+    tracked on its own), and a bad APAIR_THREADS is refused."""
+    chain = chain_of("ARRRRR", np.random.default_rng(9))
+    problem = homotopy.Problem.of(chain)
+    start = chain.prepare_ik()
+    p1 = problem.target(chain.fk(np.array([0.4, -0.3, 0.2, 0.9, -0.5, 0.1])))
+    out = {}
+    for threads in ("1", "3"):
+        monkeypatch.setenv("APAIR_THREADS", threads)
+        out[threads] = homotopy.track(problem, start.p0, p1, np.exp(0.3j), start.solutions)
+    for a, b in zip(out["1"], out["3"]):
+        assert np.array_equal(a, b)
+    monkeypatch.setenv("APAIR_THREADS", "two")
+    with pytest.raises(ValueError, match="APAIR_THREADS"):
+        homotopy.track(problem, start.p0, p1, np.exp(0.3j), start.solutions)
+
+
 def test_ik_without_the_c_kernels():
     """With the NumPy backend, n = 6 is solved by the NumPy tracker (slower, the same answer)."""
     from apair import kernels

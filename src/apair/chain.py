@@ -344,13 +344,14 @@ class AChain:
 
         Chains of 1 to 6 sinusoidal A-pairs or R-pairs. n ≤ 4 by kinematic mapping (see apair.ik):
         the left half's constraint variety on the right part's image, eliminated to eigenvalue and
-        univariate problems. n = 5, 6 by parameter homotopy (see apair.homotopy) from the design's
-        start system (`prepare_ik`, cached on disk), every complex solution tracked to T.
+        univariate problems. 5 and 6 R-pairs by the 6R elimination (apair.ik6r) where it certifies
+        its 16 solutions; otherwise n = 5, 6 by parameter homotopy (see apair.homotopy) from the
+        design's start system (`prepare_ik`, cached on disk), every complex solution tracked to T.
         Angles in (−2π, 2π] for A-pairs, (−π, π] for R-pairs.
         full=True returns an `apair.ik.Solution`: q, error, candidates, complex_count, `inside`
         (whether each solution is within `limits`) and `certified` (False where the elimination
         degenerated and a local search supplied the solutions, or, for n = 5, 6, the start set's
-        count was not reproduced or a path was lost: the set may be incomplete).
+        count was not reproduced or a path was lost: the set may be incomplete) and `method`.
         """
         from .ik import Solver
 

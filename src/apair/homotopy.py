@@ -35,6 +35,7 @@ import json
 import math
 import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -96,13 +97,18 @@ class Problem:
         return json.dumps({"kind": self.kind.tolist(), "pair": [float(x).hex() for x in self.pair[:, 0]],
                            "dh": [[float(x).hex() for x in row] for row in self.dh], "joints": self.joints})
 
-    def target(self, T: np.ndarray) -> np.ndarray:
-        """The pose (t, q) (7,) the 6 tracked joints must reach for the chain to reach T (4 × 4):
-        T in units of scale, times the virtual joints at 0."""
+    def pose(self, T: np.ndarray) -> np.ndarray:
+        """The pose (4 × 4) the 6 tracked joints must reach for the chain to reach T (4 × 4): T in
+        units of scale, times the virtual joints at 0."""
         Ts = np.array(T, float)
         Ts[:3, 3] /= self.scale
         for a, alpha, c, phi in self.dh[self.joints:]:
             Ts = Ts @ _dh(0.0, a, alpha, c, phi)
+        return Ts
+
+    def target(self, T: np.ndarray) -> np.ndarray:
+        """pose(T) as (t, q) (7,), the homotopy's pose coordinates."""
+        Ts = self.pose(T)
         return np.concatenate([Ts[:3, 3], from_matrix(Ts)[:4]]).astype(complex)
 
 
@@ -132,18 +138,28 @@ def law(problem: Problem, theta: np.ndarray):
 
     v = np.exp(0.5j * np.asarray(theta))
     out = np.empty(v.shape + (4,), complex)
-    for i, k in enumerate(problem.kind):
-        vi = np.stack([v[..., i].real, v[..., i].imag], -1)[..., None, :]
+    for k in (0, 1):  # one call per kind of pair, over its joints
+        idx = np.flatnonzero(problem.kind == k)
+        if len(idx) == 0:
+            continue
+        vi = _pairs(v[..., idx])[..., None, :]
         if k == 0:
             (res,) = kernels.call("ik_law_revolute", vi)
         else:
-            (res,) = kernels.call("ik_law_sinusoidal", vi, np.full(v.shape[:-1] + (1,), problem.pair[i, 0]))
-        out[..., i, :] = res[..., 0] + 1j * res[..., 1]
+            (res,) = kernels.call("ik_law_sinusoidal", vi, np.broadcast_to(problem.pair[idx, :1], vi.shape[:-2] + (1,)))
+        out[..., idx, :] = _complex(res)
     return out
 
 
 def _pairs(z: np.ndarray) -> np.ndarray:
-    return np.stack([z.real, z.imag], -1)
+    """Complex z (...) as (..., 2) (real, imaginary) float64 (a view where z is contiguous)."""
+    z = np.ascontiguousarray(z, complex)
+    return z.view(np.float64).reshape(z.shape + (2,))
+
+
+def _complex(a: np.ndarray) -> np.ndarray:
+    """(..., 2) (real, imaginary) pairs as complex (...)."""
+    return a[..., 0] + 1j * a[..., 1]
 
 
 def system(problem: Problem, theta: np.ndarray, target: np.ndarray, direction: np.ndarray):
@@ -152,8 +168,7 @@ def system(problem: Problem, theta: np.ndarray, target: np.ndarray, direction: n
 
     lw = law(problem, theta)
     F, dF, dFs = kernels.call(f"ik_system{problem.n}", _pairs(lw), _pairs(target), _pairs(direction), problem.dh)
-    c = lambda a: a[..., 0] + 1j * a[..., 1]  # noqa: E731
-    return c(F), c(dF), c(dFs)
+    return _complex(F), _complex(dF), _complex(dFs)
 
 
 def _linear_pose(problem: Problem, theta: np.ndarray):
@@ -236,9 +251,10 @@ class _Index:
         """Adds θ unless it is already there; whether it was new."""
         return self.place(theta)[0]
 
-    def place(self, theta) -> tuple[bool, int]:
-        """Adds θ unless it is already there: (whether it was new, its row)."""
-        theta = canonical(self.problem, np.asarray(theta))
+    def place(self, theta, is_canonical: bool = False) -> tuple[bool, int]:
+        """Adds θ unless it is already there: (whether it was new, its row). is_canonical: θ is
+        already canonical (a batch canonicalised at once)."""
+        theta = np.asarray(theta) if is_canonical else canonical(self.problem, np.asarray(theta))
         key = int(math.floor(theta[0].imag / (100 * SAME)))
         for k in (key - 1, key, key + 1):
             for j in self.buckets.get(k, ()):
@@ -272,12 +288,40 @@ def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None
         if engine == "c":
             raise RuntimeError("engine: the compiled C kernels are not installed")
         return track_numpy(problem, p0, p1, gamma, start)
-    return native.ik_track(problem.kind, problem.pair, problem.dh, np.ascontiguousarray(p0, complex),
-                           np.ascontiguousarray(p1, complex), complex(gamma), start)
+    args = (problem.kind, problem.pair, problem.dh, np.ascontiguousarray(p0, complex),
+            np.ascontiguousarray(p1, complex), complex(gamma))
+    threads = min(threads_for_tracking(), len(start) // PATHS_PER_THREAD)
+    if threads <= 1:
+        return native.ik_track(*args, start)
+    # the paths are independent and the C tracker releases the GIL: one share per thread
+    parts = [_pool(threads).submit(native.ik_track, *args, np.ascontiguousarray(share))
+             for share in np.array_split(start, threads)]
+    parts = [f.result() for f in parts]
+    return tuple(np.concatenate([part[i] for part in parts]) for i in range(4))
+
+
+PATHS_PER_THREAD = 8  # fewer paths than this per thread are tracked in the calling thread
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+
+
+def threads_for_tracking() -> int:
+    """Threads that track paths at once: $APAIR_THREADS, else the CPUs this process may run on."""
+    text = os.environ.get("APAIR_THREADS", "").strip()
+    if text:
+        if not text.isdigit() or int(text) < 1:
+            raise ValueError(f"APAIR_THREADS: expected a positive whole number of threads, got {text!r}")
+        return int(text)
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+def _pool(threads: int) -> ThreadPoolExecutor:
+    if threads not in _POOLS:
+        _POOLS[threads] = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="apair-track")
+    return _POOLS[threads]
 
 
 # The tracker's settings: those of apair_ik_default_options in generated/c/apair_ik.c.
-TRACK = {"initial_step": 0.05, "max_step": 0.25, "min_step": 1e-12, "max_steps": 500, "corrector_steps": 3,
+TRACK = {"initial_step": 0.1, "max_step": 0.5, "min_step": 1e-12, "max_steps": 500, "corrector_steps": 3,
          "path_tol": 1e-7, "final_tol": 1e-14, "final_steps": 30, "divergence": 40.0, "singular_cond": 1e10}
 
 
@@ -290,8 +334,7 @@ def _batched(problem: Problem, theta, s, p0, dp):
     target = p0[None, :] + s[:, None] * dp[None, :]
     F, dF, dFs = kernels.call(f"ik_system{problem.n}", _pairs(lw), _pairs(target),
                               _pairs(np.broadcast_to(dp, target.shape)), problem.dh)
-    c = lambda a: a[..., 0] + 1j * a[..., 1]  # noqa: E731
-    return c(F), c(dF), c(dFs)
+    return _complex(F), _complex(dF), _complex(dFs)
 
 
 def _solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -320,6 +363,7 @@ def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
     tau, h = np.zeros(k), np.full(k, o["initial_step"])
     good, steps = np.zeros(k, int), np.zeros(k, int)
     status = np.full(k, -1)
+    k1s, have = np.zeros_like(v), np.zeros(k, bool)  # dv/dτ at (v, τ), as the C tracker keeps it
 
     def s_of(t):
         den = 1 + (g - 1) * t
@@ -330,16 +374,19 @@ def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
         _, J, Fs = _batched(problem, x, s, p0, dp)
         return _solve(J, -(Fs * ds[:, None]))
 
-    def correct(x, t, iters, tol):
+    def correct(x, t, iters, tol, kt=None):
+        """Newton in place on x; kt (if given): the tangent at the last point evaluated."""
         ok, prev, last = np.zeros(len(x), bool), np.full(len(x), np.inf), np.full(len(x), np.inf)
         live = np.ones(len(x), bool)
-        s, _ = s_of(t)
+        s, ds = s_of(t)
         for it in range(iters):
             if not live.any():
                 break
-            F, J, _ = _batched(problem, x[live], s[live], p0, dp)
+            F, J, Fs = _batched(problem, x[live], s[live], p0, dp)
             d = _solve(J, -F)
             idx = np.flatnonzero(live)
+            if kt is not None:
+                kt[idx] = _solve(J, -(Fs * ds[idx, None]))
             x[idx] += d
             dn = np.abs(d).max(1)
             last[idx] = dn
@@ -364,15 +411,21 @@ def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
             act = act[~long]
             hh = np.minimum(h[act], 1 - tau[act])
             x, t = v[act], tau[act]
-            k1 = tangent(x, t)
+            need = ~have[act]
+            if need.any():
+                k1s[act[need]] = tangent(x[need], t[need])
+            k1 = k1s[act]
+            have[act] = np.all(np.isfinite(k1), axis=1)
             k2 = tangent(x + 0.5 * hh[:, None] * k1, t + 0.5 * hh)
             k3 = tangent(x + 0.5 * hh[:, None] * k2, t + 0.5 * hh)
             k4 = tangent(x + hh[:, None] * k3, t + hh)
             pred = x + hh[:, None] / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-            ok, _ = correct(pred, t + hh, o["corrector_steps"], o["path_tol"])
+            knext = np.zeros_like(pred)
+            ok, _ = correct(pred, t + hh, o["corrector_steps"], o["path_tol"], knext)
             ok &= np.all(np.isfinite(pred), axis=1)
             acc, rej = act[ok], act[~ok]
             v[acc] = pred[ok]
+            k1s[acc] = knext[ok]  # the next step's first stage, from the corrector
             tau[acc] = np.where(hh[ok] == 1 - tau[acc], 1.0, tau[acc] + hh[ok])
             good[acc] += 1
             grow = good[acc] >= 2
@@ -538,6 +591,7 @@ class Endpoints:
     paths: int
     failed: int
     diverged: int
+    singular: np.ndarray | None = None  # (k,) bool: the endpoint's Jacobian is singular (not refined)
 
 
 def solve(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 0) -> Endpoints:
@@ -552,17 +606,19 @@ def solve(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 0) ->
     p1 = problem.target(T)
     found = _Index(problem)
     owner: dict[int, int] = {}  # endpoint row -> the path that found it first
+    singular: list[bool] = []  # per endpoint row: where its first path ended SINGULAR
     todo = np.arange(start.count)
     diverged = np.zeros(start.count, bool)
     for _ in range(RETRIES + 1):
         e, s, _, _ = track(problem, start.p0, p1, _unit_gamma(rng), start.solutions[todo])
         again = {}
-        for j, endpoint, st in zip(todo, e, s):
+        for j, endpoint, st in zip(todo, canonical(problem, e), s):
             diverged[j] = st == DIVERGED
             if st in (OK, SINGULAR):  # SINGULAR: not refined to full accuracy (far out, a multiple root)
-                new, row = found.place(endpoint)
+                new, row = found.place(endpoint, is_canonical=True)
                 if new:
                     owner[row] = int(j)
+                    singular.append(st == SINGULAR)
                 elif st == OK and owner[row] != j:
                     again[int(j)] = again[owner[row]] = True
             elif st != DIVERGED:
@@ -571,12 +627,22 @@ def solve(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 0) ->
             break
         todo = np.array(sorted(again), int)
     theta = np.array(found.rows).reshape(-1, problem.n)
-    if problem.joints < 6 and len(theta):  # the chain's own solutions: the virtual joints at 0
-        v = np.exp(1j * theta[:, problem.joints:])  # the virtual joints are R-pairs
-        theta = theta[np.all(np.abs(v - 1) <= VIRTUAL_ZERO, axis=1), :problem.joints]
+    keep = own_rows(problem, theta)
     accounted = len(found.rows) + int(diverged.sum())
     complete = start.certified and accounted == start.count
-    return Endpoints(theta, complete, start.count, start.count - accounted, int(diverged.sum()))
+    return Endpoints(theta[keep, :problem.joints], complete, start.count, start.count - accounted,
+                     int(diverged.sum()), np.array(singular, bool)[keep])
+
+
+def own_rows(problem: Problem, theta: np.ndarray) -> np.ndarray:
+    """(k,) bool: which 6-joint solutions θ (k, 6) are the chain's own (the virtual joints at 0)."""
+    v = np.exp(1j * theta[:, problem.joints:])  # the virtual joints are R-pairs
+    return np.all(np.abs(v - 1) <= VIRTUAL_ZERO, axis=1)
+
+
+def own(problem: Problem, theta: np.ndarray) -> np.ndarray:
+    """The chain's own solutions (k', n) among the 6-joint solutions θ (k, 6)."""
+    return theta[own_rows(problem, theta), :problem.joints]
 
 
 def real_angles(problem: Problem, theta: np.ndarray, tol: float = REAL) -> np.ndarray:

@@ -140,6 +140,25 @@ def _periods(chain) -> np.ndarray:
     return np.array([2 * np.pi if p.kind == "revolute" else 4 * np.pi for p in chain.pairs])
 
 
+def _with_twins(chain, q: np.ndarray, near: float = 1e-4) -> np.ndarray:
+    """q (k, n) and, for each A-pair angle within `near` of ±π, the twin with the other sign: a
+    sinusoidal pair's pose curve crosses itself there (Rz(±π)·Tz(h cos(±π/2)) is one pose), so
+    two joint vectors give one pose. An elimination that solves for the right half's pose and
+    then reads its angles back sees that pose once; the twin is its second preimage."""
+    if len(q) == 0:
+        return q
+    out = [q]
+    for i, p in enumerate(chain.pairs):
+        if p.kind == "revolute":
+            continue
+        at = np.abs(np.abs(q[:, i]) - np.pi) <= near
+        if at.any():
+            twin = q[at].copy()
+            twin[:, i] = -twin[:, i]
+            out.append(twin)
+    return np.concatenate(out) if len(out) > 1 else q
+
+
 def _wrap(theta, period):
     """θ into (−period/2, period/2]."""
     return theta - period * np.ceil((theta - period / 2) / period)
@@ -242,7 +261,8 @@ class Solution:
     complex_count: solutions over the complex numbers found by the elimination (None unless
     asked for); candidates: real candidates examined; error: fk error of each solution;
     certified: False when the elimination degenerated (or found nothing) at this pose and the
-    solutions come from the local fallback search, so that the set may be incomplete."""
+    solutions come from the local fallback search, so that the set may be incomplete; method: how
+    the set was found."""
 
     q: np.ndarray
     error: np.ndarray
@@ -250,6 +270,7 @@ class Solution:
     complex_count: int | None = None
     certified: bool = True
     inside: np.ndarray | None = None  # (k,) within the chain's joint limits (set by AChain.ik)
+    method: str = "elimination"  # or "homotopy" (n = 5, 6), or "local search" (the fallback)
 
 
 class Solver:
@@ -271,7 +292,8 @@ class Solver:
         self.scale = _scale(chain)
         self.seed = seed
         self._eliminations = {}
-        self._homotopy = None  # n = 5, 6: (homotopy.Problem, its StartSystem)
+        self._problem = None  # n = 5, 6: the homotopy.Problem
+        self._start = None  # and its StartSystem, loaded when first needed
 
     def _elimination(self, reverse: bool) -> "_Elimination":
         if reverse not in self._eliminations:
@@ -296,7 +318,7 @@ class Solver:
             cands = [c for c in cands if np.all(np.abs(1 + c * c) > 1e-3 * (1 + np.abs(c) ** 2))]
             count = len(_dedupe_complex(cands)) if count_complex else None
             real = [c for c in cands if np.all(np.abs(np.imag(c)) <= CAND_TOL * (1 + np.abs(c)))]
-            q = self._elimination(reverse).angles(real)
+            q = _with_twins(self.chain, self._elimination(reverse).angles(real))
             q, err = _refine(self.chain, q, Tm, tol)
             if len(q) or not _near_reach(self.chain, Tm):
                 return Solution(q, err, len(real), count)
@@ -307,21 +329,47 @@ class Solver:
             raise ValueError(f"T: the solutions at this pose are not isolated{why}: they form a curve (e.g. "
                              "two R-pairs on one axis)")
         certified = len(q) == 0 and not degenerate  # the elimination's "none" stands
-        return Solution(q, err, 0, None, certified=certified)
+        return Solution(q, err, 0, None, certified=certified, method="local search")
 
     def _solve_homotopy(self, T, tol: float) -> Solution:
-        """n = 5, 6: every start solution tracked to T (apair.homotopy), real endpoints verified."""
-        from . import homotopy
+        """n = 5, 6: R-chains by the 6R elimination (apair.ik6r) where it certifies its 16
+        solutions; otherwise every start solution tracked to T (apair.homotopy). Real solutions
+        verified."""
+        from . import homotopy, ik6r
 
         Tm = _matrix(_study(T) if np.shape(T) == (8,) else _check_matrix(V.real_array("T", T)))
-        if self._homotopy is None:
-            problem = homotopy.Problem.of(self.chain)
-            self._homotopy = problem, homotopy.start_system(problem)
-        problem, start = self._homotopy
-        ends = homotopy.solve(problem, start, Tm)
-        real = homotopy.real_angles(problem, ends.theta)
+        if self._problem is None:
+            self._problem = homotopy.Problem.of(self.chain)
+        problem = self._problem
+        theta = ik6r.solve(problem, Tm) if ik6r.applies(problem) else None
+        if theta is not None:
+            theta, complete, method = homotopy.own(problem, theta), True, "elimination"
+        else:
+            if self._start is None:
+                self._start = homotopy.start_system(problem)
+            ends = homotopy.solve(problem, self._start, Tm)
+            theta, complete, method = ends.theta, ends.complete, "homotopy"
+            self._refuse_continuum(problem, ends, Tm, tol)
+        real = homotopy.real_angles(problem, theta)
         q, err = _refine(self.chain, real, Tm, tol)
-        return Solution(q, err, len(real), len(ends.theta), certified=ends.complete)
+        return Solution(q, err, len(real), len(theta), certified=complete, method=method)
+
+    def _refuse_continuum(self, problem, ends, Tm: np.ndarray, tol: float) -> None:
+        """ValueError where the pose has a curve of real solutions (a wrist singularity: two R-pair
+        axes in line). Paths then end at singular points of the curve's complexification, often not
+        real ones: the real part of such an endpoint, corrected onto the pose, is a real point of
+        the curve, where a step along the Jacobian's null space stays on the pose."""
+        from . import homotopy
+
+        singular = ends.theta[ends.singular] if ends.singular is not None else ends.theta[:0]
+        if len(singular) == 0:
+            return
+        q = homotopy.real_angles(problem, singular.real.astype(complex))
+        q, _ = _refine(self.chain, local_search(self.chain, Tm, start=q), Tm, tol)
+        for k in np.flatnonzero(_rank(self.chain, q) < self.chain.n):
+            if _on_continuum(self.chain, q[k], Tm, tol):
+                raise ValueError("T: the solutions at this pose are not isolated: they form a curve (e.g. a wrist "
+                                 "singularity, two R-pair axes in line)")
 
 
 class _Elimination:
@@ -654,15 +702,18 @@ def _study(T) -> np.ndarray:
     raise ValueError(f"T: expected a 4x4 transform or an 8-vector Study point, got shape {T.shape}")
 
 
+_LAST_ROW, _EYE3 = np.array([0.0, 0, 0, 1]), np.eye(3)
+
+
 def _check_matrix(T: np.ndarray) -> np.ndarray:
     """T (4, 4) or a stack (..., 4, 4) of rigid transforms, checked at once: last row [0, 0, 0, 1],
     rotation part orthonormal with det +1."""
     rows = T[..., 3, :].reshape(-1, 4)
-    bad = np.flatnonzero(~np.all(np.isclose(rows, [0, 0, 0, 1], atol=1e-12), axis=1))
+    bad = np.flatnonzero(~np.all(np.abs(rows - _LAST_ROW) <= 1e-12 + 1e-5 * _LAST_ROW, axis=1))
     if len(bad):
         raise ValueError(f"T: last row must be [0, 0, 0, 1], got {rows[bad[0]].tolist()}")
     R = T[..., :3, :3]
-    ortho = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1))
+    ortho = np.abs(np.swapaxes(R, -1, -2) @ R - _EYE3).max(axis=(-2, -1))
     if np.any(~(ortho <= 1e-9)) or np.any(np.linalg.det(R) < 0):
         raise ValueError("T: the rotation part is not a proper rotation (orthonormal, det +1)")
     return T
@@ -692,19 +743,14 @@ def _refine(chain, q: np.ndarray, T: np.ndarray, tol: float):
     q = _wrap(q, periods)
     keep = err <= tol
     q, err = q[keep], err[keep]
-    order = np.argsort(err, kind="stable")
-    out, errs = [], []
-    for k in order:
-        d = np.abs(q[k] - np.array(out)) if out else None
-        if d is not None:
-            d = np.minimum(d, periods - d)
-            if np.any(np.all(d < 1e-6, axis=1)):
-                continue
-        out.append(q[k])
-        errs.append(err[k])
-    if not out:
+    if len(q) == 0:
         return np.zeros((0, chain.n)), np.zeros(0)
-    out, errs = np.array(out), np.array(errs)
+    order = np.argsort(err, kind="stable")
+    q, err = q[order], err[order]
+    d = np.abs(q[:, None] - q[None])
+    same = np.all(np.minimum(d, periods - d) < 1e-6, axis=-1)  # (k, k)
+    first = ~np.any(np.tril(same, -1), axis=1)  # not a copy of a more accurate one before it
+    out, errs = q[first], err[first]
     order = np.lexsort(out.T[::-1])
     return out[order], errs[order]
 
@@ -731,7 +777,8 @@ def _pose_error(chain, q: np.ndarray, T: np.ndarray):
     difference."""
     F = chain.fk(q)
     dp = (T[:3, 3] - F[:, :3, 3]) / _scale(chain)
-    dw = 0.5 * np.cross(F[:, :3, :3], T[:3, :3], axisa=1, axisb=0, axisc=1).sum(axis=2)
+    S = T[:3, :3] @ np.swapaxes(F[:, :3, :3], 1, 2)  # Σ_k f_k × t_k = vee(T Fᵀ − F Tᵀ) (columns f_k, t_k)
+    dw = 0.5 * np.stack([S[:, 2, 1] - S[:, 1, 2], S[:, 0, 2] - S[:, 2, 0], S[:, 1, 0] - S[:, 0, 1]], 1)
     return np.concatenate([dp, dw], 1), np.abs(F - T).max(axis=(1, 2))
 
 

@@ -37,30 +37,40 @@ def to_matrix(study) -> np.ndarray:
     return T
 
 
+def _shepperd() -> tuple[np.ndarray, np.ndarray]:
+    """(C, D): the symmetric 4 × 4 matrix K = C·R + D whose rows are proportional to the quaternion
+    of R, row k the best-conditioned where K_kk is largest (Shepperd): K_kk = 4 x_k²."""
+    C, D = np.zeros((4, 4, 3, 3)), np.eye(4)
+    for k in range(4):  # the diagonal: 1 + tr(R) and 1 + 2 R_jj − tr(R)
+        for j in range(3):
+            C[k, k, j, j] = -1.0 if k > 0 else 1.0
+        if k > 0:
+            C[k, k, k - 1, k - 1] = 1.0
+    for k, (a, b) in enumerate(((2, 1), (0, 2), (1, 0)), start=1):  # row 0: R_ab − R_ba
+        C[0, k, a, b] = C[k, 0, a, b] = 1.0
+        C[0, k, b, a] = C[k, 0, b, a] = -1.0
+    for j, k, (a, b) in ((1, 2, (0, 1)), (1, 3, (0, 2)), (2, 3, (1, 2))):  # the rest: R_ab + R_ba
+        C[j, k, a, b] = C[j, k, b, a] = C[k, j, a, b] = C[k, j, b, a] = 1.0
+    return C.reshape(16, 9).T, D
+
+
+_SHEPPERD = _shepperd()
+# y = ½ t x̃ with t = (0, t1, t2, t3): y_i = ½ Σ L[i, a, b] t_a x_b
+_HALF_T = np.array([[[0, -1, 0, 0], [0, 0, -1, 0], [0, 0, 0, -1]],
+                    [[1, 0, 0, 0], [0, 0, 0, 1], [0, 0, -1, 0]],
+                    [[0, 0, 0, -1], [1, 0, 0, 0], [0, 1, 0, 0]],
+                    [[0, 0, 1, 0], [0, -1, 0, 0], [1, 0, 0, 0]]], float)
+
+
 def from_matrix(T) -> np.ndarray:
     """(..., 4, 4) rigid transforms -> unit Study points (Shepperd's branch choice for x)."""
     T = np.asarray(T, dtype=np.float64)
-    R, t = T[..., :3, :3], T[..., :3, 3]
-    tr = np.trace(R, axis1=-2, axis2=-1)
-    cands = np.stack([
-        np.stack([1 + tr, R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1),
-        np.stack([R[..., 2, 1] - R[..., 1, 2], 1 + 2 * R[..., 0, 0] - tr, R[..., 0, 1] + R[..., 1, 0], R[..., 0, 2] + R[..., 2, 0]], -1),
-        np.stack([R[..., 0, 2] - R[..., 2, 0], R[..., 0, 1] + R[..., 1, 0], 1 + 2 * R[..., 1, 1] - tr, R[..., 1, 2] + R[..., 2, 1]], -1),
-        np.stack([R[..., 1, 0] - R[..., 0, 1], R[..., 0, 2] + R[..., 2, 0], R[..., 1, 2] + R[..., 2, 1], 1 + 2 * R[..., 2, 2] - tr], -1),
-    ], -2)
-    diag = np.stack([1 + tr, 1 + 2 * R[..., 0, 0] - tr, 1 + 2 * R[..., 1, 1] - tr, 1 + 2 * R[..., 2, 2] - tr], -1)
-    k = np.argmax(diag, axis=-1)
-    x = np.take_along_axis(cands, k[..., None, None], axis=-2)[..., 0, :]
+    C, D = _SHEPPERD
+    K = (T[..., :3, :3].reshape(T.shape[:-2] + (9,)) @ C).reshape(T.shape[:-2] + (4, 4)) + D
+    k = np.argmax(np.diagonal(K, axis1=-2, axis2=-1), axis=-1)
+    x = np.take_along_axis(K, k[..., None, None], axis=-2)[..., 0, :]
     x = x / np.linalg.norm(x, axis=-1, keepdims=True)
-    w, a, b, c = np.moveaxis(x, -1, 0)
-    t1, t2, t3 = np.moveaxis(t, -1, 0)
-    # y = ½ t x with t = (0, t1, t2, t3)
-    y = 0.5 * np.stack([
-        -t1 * a - t2 * b - t3 * c,
-        t1 * w + t2 * c - t3 * b,
-        -t1 * c + t2 * w + t3 * a,
-        t1 * b - t2 * a + t3 * w,
-    ], -1)
+    y = 0.5 * np.einsum("...a,iab,...b->...i", T[..., :3, 3], _HALF_T, x)
     return np.concatenate([x, y], -1)
 
 

@@ -1,0 +1,164 @@
+"""The 6R elimination (apair.ik6r, derivations/chain_ik6r.py): the derived equations at random 6R
+poses, the same 16 complex solutions as the homotopy on random and special designs, the chain read
+from its end, the fallback where it cannot certify, 5R chains through the virtual joint."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import apair
+from apair import homotopy, ik6r
+
+PI = np.pi
+
+
+def arm(a, alpha, offset, phi=None) -> apair.AChain:
+    return apair.AChain([apair.APair.revolute() for _ in a], a, alpha, offset, phi)
+
+
+def random_arm(rng, n: int = 6) -> apair.AChain:
+    return arm(rng.uniform(0.1, 0.5, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.2, 0.2, n),
+               rng.uniform(-1.0, 1.0, n))
+
+
+def same_sets(A: np.ndarray, B: np.ndarray, tol: float = 1e-6) -> bool:
+    """Whether the complex solution sets agree (R-pair angles modulo 2π)."""
+    if len(A) != len(B):
+        return False
+    for b in B:
+        d = A - b
+        re = np.abs(d.real) % (2 * PI)
+        if not np.any(np.max(np.maximum(np.minimum(re, 2 * PI - re), np.abs(d.imag)), axis=1) < tol):
+            return False
+    return True
+
+
+def contains(sols, q, tol=1e-7) -> bool:
+    d = np.abs((sols - q + PI) % (2 * PI) - PI)
+    return bool(len(sols)) and bool(np.any(np.all(d < tol, axis=1)))
+
+
+def test_derived_equations_hold_at_random_poses():
+    """P(ψ3) X45 = Q X12 at random real 6R poses, in 40-digit arithmetic, through the DH product."""
+    from apair.derivations import chain_ik6r
+
+    assert chain_ik6r.check_equations(chain_ik6r.spec(), samples=2) < 1e-30
+
+
+def test_the_same_16_solutions_as_the_homotopy():
+    rng = np.random.default_rng(21)
+    for _ in range(2):
+        chain = random_arm(rng)
+        problem = homotopy.Problem.of(chain)
+        start = homotopy.start_system(problem)
+        for q in rng.uniform(-PI, PI, (3, 6)):
+            T = chain.fk(q)
+            theta = ik6r.solve(problem, T)
+            assert theta is not None and theta.shape == (16, 6)
+            ends = homotopy.solve(problem, start, T)
+            assert ends.complete and same_sets(homotopy.canonical(problem, theta), ends.theta)
+            sol = chain.ik(T, full=True)
+            assert sol.method == "elimination" and sol.certified and sol.complex_count == 16
+            assert contains(sol.q, q) and np.abs(chain.fk(sol.q) - T).max() <= 1e-9
+
+
+def test_reversed_chain_reaches_the_inverse_pose():
+    rng = np.random.default_rng(4)
+    chain = random_arm(rng)
+    problem = homotopy.Problem.of(chain)
+    q = rng.uniform(-PI, PI, 6)
+    psi = q + problem.dh[:, 3]
+    dh_rev, T_rev = ik6r.reversed_chain(problem.dh, problem.pose(chain.fk(q)))
+    F = np.eye(4)
+    for j in range(6):
+        a, alpha, c, _ = dh_rev[j]
+        F = F @ homotopy._dh(-psi[5 - j], a, alpha, c, 0.0)
+    assert np.abs(F - T_rev).max() < 1e-12
+
+
+# designs users build: (a, α, c), and whether the elimination must certify generic poses of it
+SPECIAL = {
+    "axes 1 and 2 parallel (read from the end)": (
+        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [0.0, 0.5, -1.1, 0.9, 1.3, -0.4], [0.1, -0.1, 0.05, 0.2, -0.15, 0.07], True),
+    "axes 5 and 6 parallel": (
+        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [0.7, 0.5, -1.1, 0.9, 0.0, -0.4], [0.1, -0.1, 0.05, 0.2, -0.15, 0.07], True),
+    "right angles": (
+        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [PI / 2, -PI / 2, PI / 2, PI / 2, -PI / 2, PI / 2], [0.1, -0.1, 0.05, 0.2, -0.15, 0.07], True),
+    "intersecting axes 3, 4 (a3 = 0), no offsets": (
+        [0.3, 0.4, 0.0, 0.25, 0.15, 0.1], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4], [0.0] * 6, True),
+    "millimetre scale": (
+        [3e-4, 4e-4, 2e-4, 2.5e-4, 1.5e-4, 1e-4], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4], [1e-4, -1e-4, 5e-5, 2e-4, -1.5e-4, 7e-5], True),
+    "kilometre scale": (
+        [300.0, 400.0, 200.0, 250.0, 150.0, 100.0], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4], [100.0, -100.0, 50.0, 200.0, -150.0, 70.0], True),
+    "PUMA-like (spherical wrist: 8 solutions)": (
+        [0.0, 0.43, 0.02, 0.0, 0.0, 0.0], [PI / 2, 0.0, PI / 2, -PI / 2, PI / 2, 0.0], [0.0, 0.0, 0.15, 0.43, 0.0, 0.1], False),
+    "UR-like (axes 2, 3, 4 parallel: 8 solutions)": (
+        [0.0, -0.425, -0.392, 0.0, 0.0, 0.0], [PI / 2, 0.0, 0.0, PI / 2, -PI / 2, 0.0], [0.089, 0.0, 0.0, 0.109, 0.094, 0.082], False),
+}
+
+
+@pytest.mark.parametrize("name", list(SPECIAL))
+def test_special_designs_stay_complete(name):
+    """Where the elimination certifies, its set is the homotopy's; where it cannot (fewer than 16
+    solutions, a singular pose), ik falls back to the homotopy; either way the round trip holds at
+    random poses and at joints of 0 and π."""
+    a, alpha, c, generic = SPECIAL[name]
+    chain = arm(a, alpha, c)
+    problem = homotopy.Problem.of(chain)
+    start = homotopy.start_system(problem)
+    rng = np.random.default_rng(len(name))
+    # joints at 0 and π (θ5 off 0 and π: the wrists of the last two designs would be singular)
+    qs = list(rng.uniform(-PI, PI, (4, 6))) + [np.array([0.0, PI, 0.3, PI, 0.5, -0.7]), np.array([PI, 0.4, 0.0, -1.0, 1.2, 0.0])]
+    certified = 0
+    for q in qs:
+        T = chain.fk(q)
+        theta = ik6r.solve(problem, T)
+        if theta is not None:
+            certified += 1
+            assert same_sets(homotopy.canonical(problem, theta), homotopy.solve(problem, start, T).theta), name
+        sol = chain.ik(T, full=True)
+        assert sol.method == ("elimination" if theta is not None else "homotopy")
+        assert contains(sol.q, q, 1e-6), (name, q, sol.q)
+        assert np.abs(chain.fk(sol.q) - T).max() <= 1e-9
+    if generic:
+        assert certified >= 4, name
+    else:
+        assert certified == 0 and start.count == 8, name
+
+
+def test_singular_pose_falls_back_to_the_homotopy():
+    """No offsets: at θ = 0 the arm is singular (a double root); the elimination declines."""
+    chain = arm([0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4], [0.0] * 6)
+    T = chain.fk(np.zeros(6))
+    assert ik6r.solve(homotopy.Problem.of(chain), T) is None
+    sol = chain.ik(T, full=True)
+    assert sol.method == "homotopy" and contains(sol.q, np.zeros(6), 1e-6)
+
+
+def test_a_wrist_singularity_is_refused():
+    """PUMA-like at θ5 = 0: axes 4 and 6 in line, a curve of solutions (θ4 + θ6 fixed)."""
+    a, alpha, c, _ = SPECIAL["PUMA-like (spherical wrist: 8 solutions)"]
+    chain = arm(a, alpha, c)
+    with pytest.raises(ValueError, match="not isolated"):
+        chain.ik(chain.fk(np.array([0.3, -0.5, 0.4, 0.7, 0.0, 0.2])))
+
+
+def test_five_r_chains_through_the_virtual_joint():
+    rng = np.random.default_rng(8)
+    chain = random_arm(rng, 5)
+    for q in rng.uniform(-PI, PI, (4, 5)):
+        T = chain.fk(q)
+        sol = chain.ik(T, full=True)
+        assert sol.method == "elimination" and sol.certified and sol.complex_count == 1
+        assert contains(sol.q, q)
+    T = chain.fk(rng.uniform(-PI, PI, 5))
+    T[:3, 3] += [0.01, -0.02, 0.015]  # off the 5-dimensional image
+    assert chain.ik(T).shape == (0, 5)
+
+
+def test_unreachable_pose_has_16_complex_and_no_real_solutions():
+    chain = random_arm(np.random.default_rng(2))
+    T = np.eye(4)
+    T[:3, 3] = [10.0, 0.0, 0.0]
+    sol = chain.ik(T, full=True)
+    assert sol.q.shape == (0, 6) and sol.method == "elimination" and sol.complex_count == 16
