@@ -293,10 +293,13 @@ def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None
     threads = min(threads_for_tracking(), len(start) // PATHS_PER_THREAD)
     if threads <= 1:
         return native.ik_track(*args, start)
-    # the paths are independent and the C tracker releases the GIL: one share per thread
-    parts = [_pool(threads).submit(native.ik_track, *args, np.ascontiguousarray(share))
-             for share in np.array_split(start, threads)]
-    parts = [f.result() for f in parts]
+    # the paths are independent and the C tracker releases the GIL: one share per thread, the
+    # last one tracked by the calling thread
+    shares = np.array_split(start, threads)
+    futures = [_pool(threads - 1).submit(native.ik_track, *args, np.ascontiguousarray(share))
+               for share in shares[:-1]]
+    last = native.ik_track(*args, np.ascontiguousarray(shares[-1]))
+    parts = [f.result() for f in futures] + [last]
     return tuple(np.concatenate([part[i] for part in parts]) for i in range(4))
 
 
