@@ -91,6 +91,34 @@ def _common_roots(polys: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return roots[_relres(polys, roots) <= ROOT_RTOL]
 
 
+def _common_roots_many(polys: np.ndarray, rng: np.random.Generator) -> list:
+    """_common_roots of each system polys[r] (R, k, D+1) at once: one random combination per
+    system, the companion matrices of equal degree in one batched eigenvalue call; None for a
+    system whose polynomials all vanish identically."""
+    size = np.abs(polys).max(axis=2)  # (R, k)
+    live = size > 1e-13 * np.maximum(size.max(axis=1, keepdims=True), 1e-300)
+    polys = np.where(live[:, :, None], polys, 0)  # a dropped polynomial: zero in the combination
+    comb = np.einsum("rk,rkm->rm", rng.standard_normal(live.shape) * live, polys)
+    nonzero = comb != 0
+    degree = np.where(nonzero.any(axis=1), polys.shape[2] - 1 - np.argmax(nonzero[:, ::-1], axis=1), 0)
+    out: list = [None if not live[r].any() else np.zeros(0, complex) for r in range(len(polys))]
+    for d in np.unique(degree[degree >= 1]):
+        rows = np.flatnonzero((degree == d) & live.any(axis=1))
+        if len(rows) == 0:
+            continue
+        A = np.zeros((len(rows), d, d), comb.dtype)
+        A[:, 0, :] = -comb[rows, d - 1::-1] / comb[rows, d, None]  # np.roots' companion form
+        A[:, np.arange(1, d), np.arange(d - 1)] = 1
+        roots = np.linalg.eigvals(A)  # (rows, d)
+        pw = roots[:, :, None] ** np.arange(polys.shape[2])
+        num = np.abs(np.einsum("rim,rkm->rik", pw, polys[rows])).max(axis=2)
+        den = np.einsum("rim,rm->ri", np.abs(pw), np.abs(polys[rows]).max(axis=1))
+        ok = num / np.maximum(den, 1e-300) <= ROOT_RTOL
+        for j, r in enumerate(rows):
+            out[r] = roots[j][ok[j]]
+    return out
+
+
 def _mobius(coeffs: np.ndarray, tau: float) -> np.ndarray:
     """(D+1, ...) coefficients of p(u) → those of (1 − τv)^D p((v + τ)/(1 − τv))."""
     P = np.polynomial.polynomial
@@ -438,6 +466,33 @@ class _Elimination:
             out += [np.array([u1, u2]) for u2 in _on_curve(self.joints[1], Z, self.rng)]
         return out
 
+    def _solve_left_many(self, Ws: np.ndarray) -> list[list[np.ndarray]]:
+        """_solve_left(W, 2) for each row of Ws (R, 8), the common roots of all rows at once."""
+        if len(Ws) == 0:
+            return []
+        Zc = np.einsum("mab,rb->rma", self.Zmap, Ws)  # (R, D1+1, 8)
+        outside = Zc[:, :, OUTSIDE]
+        coaxial = np.abs(outside).max(axis=(1, 2)) <= 1e-10 * np.abs(Zc).max(axis=(1, 2))
+        out: list = [self._solve_coaxial(Zc[r]) if coaxial[r] else [] for r in range(len(Ws))]
+        rows = np.flatnonzero(~coaxial)
+        u1s = _common_roots_many(np.swapaxes(outside[rows], 1, 2), self.rng)
+        if any(u is None for u in u1s):
+            raise _Degenerate("every polynomial vanishes identically")
+        owner = np.concatenate([np.full(len(u), r) for r, u in zip(rows, u1s)] + [np.zeros(0, int)]).astype(int)
+        u1 = np.concatenate(list(u1s) + [np.zeros(0, complex)])
+        if len(u1) == 0:
+            return out
+        Z = np.einsum("km,kma->ka", u1[:, None] ** np.arange(Zc.shape[1]), Zc[owner])  # (K, 8)
+        a, b = _PAIRS
+        P = self.joints[1].P
+        minors = P[None, :, a] * Z[:, None, b] - P[None, :, b] * Z[:, None, a]  # (K, D+1, 28)
+        u2s = _common_roots_many(np.swapaxes(minors, 1, 2), self.rng)
+        if any(u is None for u in u2s):
+            raise _Degenerate("every polynomial vanishes identically")
+        for r, x, u2 in zip(owner, u1, u2s):
+            out[r] += [np.array([x, y]) for y in u2]
+        return out
+
     def _solve_coaxial(self, Zc: np.ndarray) -> list[np.ndarray]:
         """Joints 1 and 2 on one axis (a_1 = 0, α_1 = 0): Z(u_1) lies in the pair subalgebra for
         every u_1, so u_1 and u_2 come together from Z(u_1) ∝ P_2(u_2): the 2×2 minors of the
@@ -494,10 +549,8 @@ class _Elimination:
         polys = np.zeros(outer.shape[:2] + (2 * D - 1,), dtype=outer.dtype)
         for j in range(D):
             polys[:, :, j: j + D] += outer[:, :, j, :]
-        for u3, P, Wc in zip(u3s, polys, Cu):
-            try:
-                u4s = _common_roots(P, self.rng)
-            except _Degenerate:
+        for u3, u4s, Wc in zip(u3s, _common_roots_many(polys, self.rng), Cu):
+            if u4s is None:  # every quadric vanishes for all u4 at this u3
                 continue
             if real:
                 u4s = u4s[np.abs(u4s.imag) <= CAND_TOL * (1 + np.abs(u4s))].real
@@ -525,8 +578,8 @@ class _Elimination:
             rights, images = self._right_pairs(u3s, C, real=not count_complex)
             rights, images = _with_cluster_means(rights, images, C)
         out = []
-        for right, W in zip(rights, images):
-            out += [np.concatenate([left, right]) for left in self._solve_left(W, 2)]
+        for right, lefts in zip(rights, self._solve_left_many(np.asarray(images).reshape(-1, 8))):
+            out += [np.concatenate([left, right]) for left in lefts]
         return out
 
 
