@@ -30,6 +30,7 @@ import random
 import mpmath
 import sympy as sp
 
+from .chain_ik import _mp_dh
 from .spec import Arg, KernelSpec
 
 SOURCE = "derivations/chain_ik6r.py"
@@ -161,12 +162,6 @@ def spec() -> KernelSpec:
 
 
 # ----------------------------------------------------------------------------- independent check
-def _mp_dh(psi, a, alpha, c):
-    ct, st, ca, sa = mpmath.cos(psi), mpmath.sin(psi), mpmath.cos(alpha), mpmath.sin(alpha)
-    return mpmath.matrix([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, c],
-                          [0, 0, 0, 1]])
-
-
 def check_equations(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> float:
     """Largest |P(ψ3) X45 − Q X12| / (1 + |P(ψ3) X45|) at random real 6R poses T = A_1 … A_6 (mpmath
     DH product), the kernel's steps and outputs evaluated in `digits`-digit arithmetic."""
@@ -179,7 +174,7 @@ def check_equations(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> f
             psi = [mpmath.mpf(rng.uniform(-3, 3)) for _ in range(6)]
             T = mpmath.eye(4)
             for i in range(6):
-                T = T * _mp_dh(psi[i], dh[i][0], dh[i][1], dh[i][2])
+                T = T * _mp_dh(psi[i], 0, dh[i][0], dh[i][1], dh[i][2], 0)  # ψ_i = θ_i + φ_i
             env = {s: sp.Float(x, digits) for s, x in zip(kernel.inputs[0].symbols, [x for r in dh for x in r])}
             env.update({s: sp.Float(T[k // 4, k % 4], digits) for k, s in enumerate(kernel.inputs[1].symbols)})
             for s, e in kernel.steps:
