@@ -357,3 +357,16 @@ def test_a_path_that_jumped_is_tracked_again():
     d = np.abs((sol.q - q + per / 2) % per - per / 2)
     assert np.any(np.all(d < 1e-7, axis=1)), sol
     assert sol.complex_count == 48 and sol.certified
+
+
+def test_tracking_in_a_forked_child():
+    """A child forked after the parent's tracking threads started makes its own (no hang)."""
+    import multiprocessing
+
+    chain = chain_of("ARRRRR", np.random.default_rng(9))
+    chain.prepare_ik()
+    T = chain.fk(np.array([0.4, -0.3, 0.2, 0.9, -0.5, 0.1]))
+    here = chain.ik(T)
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        there = pool.apply_async(chain.ik, (T,)).get(timeout=120)
+    assert np.array_equal(here, there)

@@ -305,6 +305,8 @@ def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None
 
 PATHS_PER_THREAD = 8  # fewer paths than this per thread are tracked in the calling thread
 _POOLS: dict[int, ThreadPoolExecutor] = {}
+if hasattr(os, "register_at_fork"):  # a forked child has none of the parent's pool threads
+    os.register_at_fork(after_in_child=_POOLS.clear)
 
 
 def threads_for_tracking() -> int:
