@@ -162,3 +162,18 @@ def test_unreachable_pose_has_16_complex_and_no_real_solutions():
     T[:3, 3] = [10.0, 0.0, 0.0]
     sol = chain.ik(T, full=True)
     assert sol.q.shape == (0, 6) and sol.method == "elimination" and sol.complex_count == 16
+
+
+def test_cli_names_the_route(tmp_path, capsys):
+    from apair.cli import main as cli
+
+    path = tmp_path / "arm.toml"
+    joints = "\n".join(f"[[joint]]\npair = \"revolute\"\na = {a}\nalpha_deg = {al}\noffset = {c}\n"
+                       for a, al, c in [(0.1, 90, 0.3), (0.4, 10, 0.0), (0.05, 80, 0.02), (0.0, -70, 0.4),
+                                        (0.02, 60, 0.0), (0.0, 20, 0.1)])
+    path.write_text(f"name = \"arm\"\n{joints}")
+    chain = apair.load(path)
+    q = np.array([0.3, -0.5, 0.8, 1.1, -0.4, 0.2])
+    assert cli(["ik", str(path), *[repr(float(x)) for x in chain.fk(q).ravel()]]) == 0
+    out = capsys.readouterr().out
+    assert "of 16 complex, by elimination; angles in rad" in out

@@ -165,7 +165,7 @@ def _cmd_ik(args) -> int:
             return 1
         complete = "" if sol.certified else "; not certified complete"
         count = f" of {sol.complex_count} complex" if sol.complex_count is not None else ""
-        print(f"{chain.name}: {len(sol.q)} real solution(s){count}{complete}; angles in rad"
+        print(f"{chain.name}: {len(sol.q)} real solution(s){count}, by {sol.method}{complete}; angles in rad"
               f"{' and deg' if args.deg else ''}")
         for q, e, ok in zip(sol.q, sol.error, sol.inside):
             extra = f"  = {np.degrees(q)} deg" if args.deg else ""
