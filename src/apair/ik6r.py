@@ -19,9 +19,10 @@ P(ψ3) X45 = Q X12 at the pose. Here, per pose:
 The answer is certified complete when 16 distinct solutions come out regular with Newton
 converged: no design has more than 16 isolated solutions at a pose (the generic count bounds the
 isolated solutions of every member of a parameterised family, and 16 is the generic 6R count).
-Anything else — a rank-deficient Q (special designs: zero lengths, parallel or intersecting
-axes), an ill-conditioned M2, the spurious roots not where they belong, a root lost or doubled —
-returns None, and the caller tracks the homotopy instead.
+Where Q loses rank (axes 1 and 2 parallel, say) the chain is read from its end
+(`reversed_chain`). Anything else — Q rank-deficient both ways, a singular M2, the spurious roots
+not where they belong, a root that does not converge, one lost or doubled (designs with fewer
+than 16 solutions, singular poses) — returns None, and the caller tracks the homotopy instead.
 """
 from __future__ import annotations
 
