@@ -401,6 +401,13 @@ def random_4a(rng) -> apair.AChain:
                         rng.uniform(-1.0, 1.0, 4))
 
 
+def _plain(x):
+    """NumPy scalars as Python numbers for json (anything else is refused as json would)."""
+    if isinstance(x, np.generic):
+        return x.item()
+    raise TypeError(f"Object of type {type(x).__name__} is not JSON serializable")
+
+
 def time_ik(chains, poses_per_chain: int, rng) -> dict:
     """Median wall time per pose of AChain.ik (every real solution, verified), after set-up."""
     times, setup, solutions = [], [], []
@@ -563,7 +570,7 @@ def main(argv=None) -> int:
     for t in results["native_targets"]:
         print(f"  [{'met' if t['met'] else 'MISSED'}] {t['target']}: {t['measured']:.3g}")
     if args.native_only:
-        args.out.write_text(json.dumps(results, indent=1) + "\n")
+        args.out.write_text(json.dumps(results, indent=1, default=_plain) + "\n")
         print(f"written to {args.out}")
         return 0
     for n in (2, 4, 6):
@@ -619,7 +626,7 @@ def main(argv=None) -> int:
     print("\ntargets:")
     for t in results["targets"]:
         print(f"  [{'met' if t['met'] else 'MISSED'}] {t['target']}: {t['measured']:.3g}")
-    args.out.write_text(json.dumps(results, indent=1) + "\n")
+    args.out.write_text(json.dumps(results, indent=1, default=_plain) + "\n")
     print(f"written to {args.out}")
     return 0
 

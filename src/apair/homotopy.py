@@ -558,7 +558,7 @@ def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4) -> St
         for a, b in ((p0, pa), (pa, pb), (pb, p0)):
             cur, status = _segment(problem, a, b, cur, rng)
             lost += int(np.sum((status == FAILED) | (status == TOO_LONG)))
-    certified = sum(c == len(sols) for c in counts) >= 2 and lost == 0
+    certified = bool(sum(c == len(sols) for c in counts) >= 2 and lost == 0)
     return StartSystem(problem.key(), p0, sols, loops, counts, certified, time.perf_counter() - t0)
 
 
