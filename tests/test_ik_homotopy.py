@@ -359,10 +359,11 @@ def test_a_path_that_jumped_is_tracked_again():
     assert sol.complex_count == 48 and sol.certified
 
 
-def test_tracking_in_a_forked_child():
+def test_tracking_in_a_forked_child(monkeypatch):
     """A child forked after the parent's tracking threads started makes its own (no hang)."""
     import multiprocessing
 
+    monkeypatch.setenv("APAIR_THREADS", "2")  # a pool in the parent on any machine
     chain = chain_of("ARRRRR", np.random.default_rng(9))
     chain.prepare_ik()
     T = chain.fk(np.array([0.4, -0.3, 0.2, 0.9, -0.5, 0.1]))
