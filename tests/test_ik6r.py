@@ -177,3 +177,12 @@ def test_cli_names_the_route(tmp_path, capsys):
     assert cli(["ik", str(path), *[repr(float(x)) for x in chain.fk(q).ravel()]]) == 0
     out = capsys.readouterr().out
     assert "of 16 complex, by elimination; angles in rad" in out
+
+
+@pytest.mark.parametrize("T, message", [(np.eye(3), "expected a 4x4 transform"), (np.full((4, 4), np.nan), "NaN"),
+                                        (np.zeros(8), "exceptional"), (np.diag([1.0, 1, -1, 1]), "proper rotation")])
+def test_bad_poses_are_refused_by_name(T, message):
+    chain = random_arm(np.random.default_rng(2))
+    with pytest.raises(ValueError, match=message) as info:
+        chain.ik(T)
+    assert str(info.value).startswith("T:")

@@ -365,7 +365,7 @@ class Solver:
         verified."""
         from . import homotopy, ik6r
 
-        Tm = _matrix(_study(T) if np.shape(T) == (8,) else _check_matrix(V.real_array("T", T)))
+        Tm = _pose_matrix(T)
         if self._problem is None:
             self._problem = homotopy.Problem.of(self.chain)
         problem = self._problem
@@ -753,6 +753,12 @@ def _study(T) -> np.ndarray:
             raise ValueError(f"T: not on the Study quadric (x·y = {x @ y:.3g})")
         return normalise(T)
     raise ValueError(f"T: expected a 4x4 transform or an 8-vector Study point, got shape {T.shape}")
+
+
+def _pose_matrix(T) -> np.ndarray:
+    """A pose given as a 4×4 matrix (kept as given) or a Study point (8,), validated → 4×4."""
+    A = V.real_array("T", T)
+    return _check_matrix(A) if A.shape == (4, 4) else _matrix(_study(A))
 
 
 _LAST_ROW, _EYE3 = np.array([0.0, 0, 0, 1]), np.eye(3)
