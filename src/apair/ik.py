@@ -457,17 +457,11 @@ class _Elimination:
         j1 = self.joints[0]
         if n == 1:
             return [np.array([u]) for u in _on_curve(j1, multiply(W, j1.Kinv), self.rng)]
-        Zc = self.Zmap @ W  # (D1+1, 8)
-        if np.abs(Zc[:, OUTSIDE]).max() <= 1e-10 * np.abs(Zc).max():
-            return self._solve_coaxial(Zc)
-        out = []
-        for u1 in _common_roots(Zc[:, OUTSIDE].T, self.rng):
-            Z = (u1 ** np.arange(len(Zc))) @ Zc
-            out += [np.array([u1, u2]) for u2 in _on_curve(self.joints[1], Z, self.rng)]
-        return out
+        return self._solve_left_many(W[None])[0]
 
     def _solve_left_many(self, Ws: np.ndarray) -> list[list[np.ndarray]]:
-        """_solve_left(W, 2) for each row of Ws (R, 8), the common roots of all rows at once."""
+        """Parameters (u_1, u_2) with A_1 A_2 ∝ W for each row of Ws (R, 8), complex: the common
+        roots of all rows at once."""
         if len(Ws) == 0:
             return []
         Zc = np.einsum("mab,rb->rma", self.Zmap, Ws)  # (R, D1+1, 8)
@@ -483,10 +477,7 @@ class _Elimination:
         if len(u1) == 0:
             return out
         Z = np.einsum("km,kma->ka", u1[:, None] ** np.arange(Zc.shape[1]), Zc[owner])  # (K, 8)
-        a, b = _PAIRS
-        P = self.joints[1].P
-        minors = P[None, :, a] * Z[:, None, b] - P[None, :, b] * Z[:, None, a]  # (K, D+1, 28)
-        u2s = _common_roots_many(np.swapaxes(minors, 1, 2), self.rng)
+        u2s = _common_roots_many(np.swapaxes(_minors(self.joints[1].P, Z), 1, 2), self.rng)
         if any(u is None for u in u2s):
             raise _Degenerate("every polynomial vanishes identically")
         for r, x, u2 in zip(owner, u1, u2s):
@@ -618,9 +609,13 @@ _PAIRS = np.triu_indices(8, 1)
 
 def _on_curve(j: _Joint, Z: np.ndarray, rng) -> np.ndarray:
     """Parameters u with P_j(u) ∝ Z: common roots of the 2×2 minors P_a Z_b − P_b Z_a."""
+    return _common_roots(_minors(j.P, Z).T, rng)
+
+
+def _minors(P: np.ndarray, Z: np.ndarray) -> np.ndarray:
+    """The 2×2 minors P_a(u) Z_b − P_b(u) Z_a (..., D+1, 28) of a curve P (D+1, 8) and points Z (..., 8)."""
     a, b = _PAIRS
-    minors = j.P[:, a] * Z[b] - j.P[:, b] * Z[a]  # (D+1, 28)
-    return _common_roots(minors.T, rng)
+    return P[:, a] * Z[..., None, b] - P[:, b] * Z[..., None, a]
 
 
 def _eval(coeffs: np.ndarray, u: np.ndarray) -> np.ndarray:
