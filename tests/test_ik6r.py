@@ -62,6 +62,39 @@ def test_the_same_16_solutions_as_the_homotopy():
             assert contains(sol.q, q) and np.abs(chain.fk(sol.q) - T).max() <= 1e-9
 
 
+def test_c_steps_agree_with_numpy():
+    """apair_ik6r_angles and apair_ik_newton against their NumPy versions: the same angles from the
+    same eigenpairs, the same roots and step sizes after Newton (also from perturbed starts, and
+    a start far out that must be reported as lost)."""
+    rng = np.random.default_rng(8)
+    chain = random_arm(rng)
+    problem = homotopy.Problem.of(chain)
+    pose = problem.pose(chain.fk(rng.uniform(-PI, PI, 6)))
+    seen = {}
+    real_angles = ik6r.angles
+
+    def spy(*args, engine=None):
+        seen["args"] = args
+        return real_angles(*args, engine=engine)
+
+    ik6r.angles = spy
+    try:
+        theta = ik6r.eliminate(problem.dh, pose)
+    finally:
+        ik6r.angles = real_angles
+    assert theta is not None and theta.shape == (16, 6)
+    assert np.abs(ik6r.angles(*seen["args"], engine="c") - ik6r.angles(*seen["args"], engine="numpy")).max() < 1e-9
+    p = homotopy.target_of(pose)
+    start = theta + 1e-3 * (rng.standard_normal(theta.shape) + 1j * rng.standard_normal(theta.shape))
+    start[0] = 40j  # |Im θ| beyond imag_max after a step: lost
+    args = (problem, start, p, 8, 1e-8, 1e-6, 0.25, ik6r.IMAG_MAX)
+    tc, sc = homotopy.newton(*args, engine="c")
+    tn, sn = homotopy.newton(*args, engine="numpy")
+    assert np.isinf(sc[0]) and np.isinf(sn[0])
+    assert np.all(sc[1:] <= 1e-8) and np.all(sn[1:] <= 1e-8)
+    assert np.abs(tc[1:] - tn[1:]).max() < 1e-9 and np.abs(tc[1:] - theta[1:]).max() < 1e-8
+
+
 def test_reversed_chain_reaches_the_inverse_pose():
     rng = np.random.default_rng(4)
     chain = random_arm(rng)

@@ -668,6 +668,77 @@ done:
     return result;
 }
 
+/* ik6r_angles(x3, vec, P, L, sigma, dh, T) -> theta */
+static PyObject *native_ik6r_angles(PyObject *self, PyObject *args)
+{
+    PyObject *o[7];
+    PyArrayObject *a[7] = {NULL};
+    PyObject *result = NULL;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &o[6])) {
+        return NULL;
+    }
+    npy_intp s_x3[1] = {-1}, s_P[2] = {14, 27}, s_L[2] = {14, 8}, s_sigma[1] = {3}, s_dh[2] = {6, 4}, s_T[2] = {4, 4};
+    if (!(a[0] = ik_array(o[0], NPY_CDOUBLE, 1, s_x3, "x3"))) goto done;
+    npy_intp count = PyArray_DIM(a[0], 0), s_vec[2] = {count, 24}, s_out[2] = {count, 6};
+    if (!(a[1] = ik_array(o[1], NPY_CDOUBLE, 2, s_vec, "vec")) || !(a[2] = ik_array(o[2], NPY_DOUBLE, 2, s_P, "P")) ||
+        !(a[3] = ik_array(o[3], NPY_DOUBLE, 2, s_L, "L")) || !(a[4] = ik_array(o[4], NPY_DOUBLE, 1, s_sigma, "sigma")) ||
+        !(a[5] = ik_array(o[5], NPY_DOUBLE, 2, s_dh, "dh")) || !(a[6] = ik_array(o[6], NPY_DOUBLE, 2, s_T, "T"))) {
+        goto done;
+    }
+    PyArrayObject *theta = (PyArrayObject *)PyArray_SimpleNew(2, s_out, NPY_CDOUBLE);
+    if (!theta) goto done;
+    apair_ik6r_angles((size_t)count, PyArray_DATA(a[0]), PyArray_DATA(a[1]), PyArray_DATA(a[2]), PyArray_DATA(a[3]),
+                      PyArray_DATA(a[4]), PyArray_DATA(a[5]), PyArray_DATA(a[6]), PyArray_DATA(theta));
+    result = (PyObject *)theta;
+done:
+    for (int i = 0; i < 7; i++) Py_XDECREF(a[i]);
+    return result;
+}
+
+/* ik_newton(kind, pair, dh, p, theta, max_steps, tol, floor, stall, imag_max) -> (theta, size) */
+static PyObject *native_ik_newton(PyObject *self, PyObject *args)
+{
+    PyObject *o[5];
+    PyArrayObject *a[5] = {NULL};
+    PyObject *result = NULL;
+    int max_steps;
+    double tol, floor_, stall, imag_max;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOidddd", &o[0], &o[1], &o[2], &o[3], &o[4], &max_steps, &tol, &floor_, &stall,
+                          &imag_max)) {
+        return NULL;
+    }
+    npy_intp nk[1] = {6}, s_pair[2] = {6, 2}, s_dh[2] = {6, 4}, s_p[1] = {7}, s_theta[2] = {-1, 6};
+    if (!(a[0] = ik_array(o[0], NPY_INT32, 1, nk, "kind")) || !(a[1] = ik_array(o[1], NPY_DOUBLE, 2, s_pair, "pair")) ||
+        !(a[2] = ik_array(o[2], NPY_DOUBLE, 2, s_dh, "dh")) || !(a[3] = ik_array(o[3], NPY_CDOUBLE, 1, s_p, "p")) ||
+        !(a[4] = ik_array(o[4], NPY_CDOUBLE, 2, s_theta, "theta"))) {
+        goto done;
+    }
+    npy_intp count = PyArray_DIM(a[4], 0), s_size[1] = {count};
+    PyArrayObject *theta = (PyArrayObject *)PyArray_NewCopy(a[4], NPY_CORDER);
+    PyArrayObject *size = (PyArrayObject *)PyArray_SimpleNew(1, s_size, NPY_DOUBLE);
+    if (!theta || !size) {
+        Py_XDECREF(theta); Py_XDECREF(size);
+        goto done;
+    }
+    apair_ik_problem pb = {6, (const int *)PyArray_DATA(a[0]), PyArray_DATA(a[1]), PyArray_DATA(a[2])};
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = apair_ik_newton(&pb, PyArray_DATA(a[3]), (size_t)count, PyArray_DATA(theta), max_steps, tol, floor_, stall,
+                         imag_max, PyArray_DATA(size));
+    Py_END_ALLOW_THREADS
+    if (rc) {
+        PyErr_SetString(PyExc_ValueError, "ik_newton: the problem is not valid (kinds 0 or 1, 6 joints)");
+        Py_DECREF(theta); Py_DECREF(size);
+        goto done;
+    }
+    result = Py_BuildValue("NN", theta, size);
+done:
+    for (int i = 0; i < 5; i++) Py_XDECREF(a[i]);
+    return result;
+}
+
 /* ik_local(kind, pair, dh, lower, upper, scale, target (count, 4, 4), seed (count, n), tol, max_iter)
  * -> (q, residual, converged) */
 static PyObject *native_ik_local(PyObject *self, PyObject *args)
@@ -729,6 +800,10 @@ static PyMethodDef native_methods[] = {
     {"kernel_address", native_kernel_address, METH_O, "kernel_address(index) -> address of the registry entry."},
     {"ik_track", native_ik_track, METH_VARARGS,
      "ik_track(kind, pair, dh, p0, p1, gamma, start) -> (end, status, steps, cond): apair_ik_track."},
+    {"ik6r_angles", native_ik6r_angles, METH_VARARGS,
+     "ik6r_angles(x3, vec, P, L, sigma, dh, T) -> theta: apair_ik6r_angles."},
+    {"ik_newton", native_ik_newton, METH_VARARGS,
+     "ik_newton(kind, pair, dh, p, theta, max_steps, tol, floor, stall, imag_max) -> (theta, size): apair_ik_newton."},
     {"ik_local", native_ik_local, METH_VARARGS,
      "ik_local(kind, pair, dh, lower, upper, scale, target, seed, tol, max_iter) -> (q, residual, converged)."},
     {NULL, NULL, 0, NULL},

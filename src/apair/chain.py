@@ -359,6 +359,8 @@ class AChain:
         if self._ik is None:
             self._ik = Solver(self)
         sol = self._ik.solve(T, tol=tol, count_complex=full)
+        if not (full or within_limits):
+            return sol.q
         inside = self.within_limits(sol.q)
         if within_limits:
             sol = dataclasses.replace(sol, q=sol.q[inside], error=sol.error[inside])

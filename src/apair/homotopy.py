@@ -108,8 +108,12 @@ class Problem:
 
     def target(self, T: np.ndarray) -> np.ndarray:
         """pose(T) as (t, q) (7,), the homotopy's pose coordinates."""
-        Ts = self.pose(T)
-        return np.concatenate([Ts[:3, 3], from_matrix(Ts)[:4]]).astype(complex)
+        return target_of(self.pose(T))
+
+
+def target_of(pose: np.ndarray) -> np.ndarray:
+    """A pose (4 × 4, in units of the scale) as the homotopy's pose coordinates (t, q) (7,)."""
+    return np.concatenate([pose[:3, 3], from_matrix(pose)[:4]]).astype(complex)
 
 
 def _dh(theta, a, alpha, c, phi) -> np.ndarray:
@@ -301,6 +305,37 @@ def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None
     last = native.ik_track(*args, np.ascontiguousarray(shares[-1]))
     parts = [f.result() for f in futures] + [last]
     return tuple(np.concatenate([part[i] for part in parts]) for i in range(4))
+
+
+def newton(problem: Problem, theta: np.ndarray, p: np.ndarray, max_steps: int, tol: float, floor: float,
+           stall: float, imag_max: float, engine: str | None = None):
+    """Newton's method on F(θ; p) = 0 at the fixed pose p (7,) from each row of theta (k, n):
+    (θ (k, n), size (k,)), size the last step's largest entry. A row stops when its step is <= tol,
+    or <= floor but above stall × the step before (the rounding floor of a root far out, where the
+    entries are e^|Im θ| large); size is inf where the Jacobian was singular, a value not finite
+    or some |Im θ| > imag_max. In C (apair_ik_newton) where installed, else NumPy, all rows at once."""
+    theta = np.ascontiguousarray(theta, complex).reshape(-1, problem.n)
+    native = _native() if engine in (None, "c") else None
+    if native is not None:
+        return native.ik_newton(problem.kind, problem.pair, problem.dh, np.ascontiguousarray(p, complex), theta,
+                                max_steps, tol, floor, stall, imag_max)
+    if engine == "c":
+        raise RuntimeError("engine: the compiled C kernels are not installed")
+    theta = theta.copy()
+    size, prev = np.full(len(theta), np.inf), np.full(len(theta), np.inf)
+    todo, still = np.ones(len(theta), bool), np.zeros(7, complex)
+    for _ in range(max_steps):
+        if not todo.any():
+            break
+        with np.errstate(all="ignore"):
+            F, dF, _ = system(problem, theta[todo], p, still)
+            step = _solve(dF, F)
+        theta[todo] -= step
+        prev[todo], size[todo] = size[todo], np.max(np.abs(step), axis=1)
+        lost = ~(np.isfinite(size) & np.all(np.abs(theta.imag) <= imag_max, axis=1))
+        size[lost] = np.inf
+        todo &= ~lost & ~((size <= tol) | ((size <= floor) & (size > stall * prev)))
+    return theta, size
 
 
 PATHS_PER_THREAD = 8  # fewer paths than this per thread are tracked in the calling thread
@@ -657,4 +692,4 @@ def real_angles(problem: Problem, theta: np.ndarray, tol: float = REAL) -> np.nd
         return np.zeros((0, n))
     real = np.all(np.abs(np.imag(theta)) <= tol, axis=1)
     kind = Problem(problem.kind[:n], problem.pair[:n], problem.dh[:n], problem.scale, n)
-    return np.real(canonical(kind, theta[real]))
+    return np.ascontiguousarray(np.real(canonical(kind, theta[real])))  # (the kernels' fast path wants it contiguous)

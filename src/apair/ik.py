@@ -563,7 +563,7 @@ class _Elimination:
             rights = [np.array([u3]) for u3 in _common_roots(G, self.rng)]
             images = [(r[0] ** np.arange(len(C))) @ C for r in rights]
         else:
-            u3s = self._resultant_roots(C, self.ximage @ LT[:4, :4].T)
+            u3s = _with_means(self._resultant_roots(C, self.ximage @ LT[:4, :4].T))
             if not count_complex:
                 u3s = u3s[np.abs(u3s.imag) <= CAND_TOL * (1 + np.abs(u3s))].real
             rights, images = self._right_pairs(u3s, C, real=not count_complex)
@@ -575,6 +575,21 @@ class _Elimination:
 
 
 # ----------------------------------------------------------------------------- helpers
+def _with_means(u: np.ndarray) -> np.ndarray:
+    """The roots u (r,) and the mean of every two that agree to CAND_TOL: a double root comes out
+    as two simple roots (or a complex pair) about √ε apart, too inaccurate for what is solved from
+    it, while their mean is accurate to about ε (the sum of roots is a smooth function of the
+    coefficients). At a pose where the left half's surface crosses itself (an A-pair at ±π) the
+    resultant has such a double root. The roots themselves are kept, and means at the isotropic
+    points u = ±i (never a displacement) are not added."""
+    if len(u) < 2:
+        return u
+    i, j = np.nonzero(np.triu(np.abs(u[:, None] - u[None]) <= CAND_TOL * (1 + np.abs(u[:, None])), 1))
+    means = (u[i] + u[j]) / 2
+    means = means[np.abs(1 + means * means) > 1e-3 * (1 + np.abs(means) ** 2)]
+    return np.concatenate([u, means]) if len(means) else u
+
+
 def _with_cluster_means(pairs: np.ndarray, images: np.ndarray, C: np.ndarray):
     """The pairs (u_3, u_4) and their images, plus the mean of every two pairs that agree to
     CAND_TOL: a double root (special poses square the resultant) comes out as two simple roots
@@ -762,6 +777,17 @@ _LAST_ROW, _EYE3 = np.array([0.0, 0, 0, 1]), np.eye(3)
 def _check_matrix(T: np.ndarray) -> np.ndarray:
     """T (4, 4) or a stack (..., 4, 4) of rigid transforms, checked at once: last row [0, 0, 0, 1],
     rotation part orthonormal with det +1."""
+    if T.shape == (4, 4):  # one pose (the common case): the same tests on Python floats, far cheaper
+        m = T.tolist()
+        if not all(abs(a - b) <= 1e-12 + 1e-5 * b for a, b in zip(m[3], (0.0, 0.0, 0.0, 1.0))):
+            raise ValueError(f"T: last row must be [0, 0, 0, 1], got {m[3]}")
+        c = [[m[0][j], m[1][j], m[2][j]] for j in range(3)]  # the rotation's columns
+        det = (c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0])
+               + c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0]))
+        if not (all(abs(sum(a * b for a, b in zip(c[i], c[j])) - (i == j)) <= 1e-9 for i in range(3) for j in range(3))
+                and det >= 0):
+            raise ValueError("T: the rotation part is not a proper rotation (orthonormal, det +1)")
+        return T
     rows = T[..., 3, :].reshape(-1, 4)
     bad = np.flatnonzero(~np.all(np.abs(rows - _LAST_ROW) <= 1e-12 + 1e-5 * _LAST_ROW, axis=1))
     if len(bad):
@@ -803,7 +829,8 @@ def _refine(chain, q: np.ndarray, T: np.ndarray, tol: float):
     q, err = q[order], err[order]
     d = np.abs(q[:, None] - q[None])
     same = np.all(np.minimum(d, periods - d) < 1e-6, axis=-1)  # (k, k)
-    first = ~np.any(np.tril(same, -1), axis=1)  # not a copy of a more accurate one before it
+    k = np.arange(len(q))
+    first = ~np.any(same & (k[:, None] > k), axis=1)  # not a copy of a more accurate one before it
     out, errs = q[first], err[first]
     order = np.lexsort(out.T[::-1])
     return out[order], errs[order]

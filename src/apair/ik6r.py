@@ -13,8 +13,10 @@ P(ψ3) X45 = Q X12 at the pose. Here, per pose:
 3. det M(x3) = 0 as a 24 × 24 eigenproblem (the companion form of M2⁻¹ M(x3)): 16 eigenvalues
    are solutions, 8 are the spurious factor (1 + x3²)⁴ (x3 = ±i, e^{iψ3} = 0 or ∞, four each).
 4. The eigenvectors are the monomial vectors: x4, x5 are ratios of their entries; X12 follows
-   from the 14 equations by least squares, ψ6 from the first column of (A1 … A5)⁻¹ T.
-5. Every solution takes Newton steps on the homotopy system (ik_system6, complex).
+   from the 14 equations by least squares, ψ6 from the first column of (A1 … A5)⁻¹ T (in C,
+   apair_ik6r_angles, where the kernels are installed).
+5. Every solution takes Newton steps on the homotopy system (ik_system6, complex; in C,
+   apair_ik_newton, where the kernels are installed).
 
 The answer is certified complete when 16 distinct solutions come out regular with Newton
 converged: no design has more than 16 isolated solutions at a pose (the generic count bounds the
@@ -29,10 +31,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.linalg import lapack
 
 from . import homotopy, kernels
 
 SIGMA = (0.4142, -0.7071, 0.5773)  # the charts' turns of ψ3, ψ4, ψ5 [rad] (fixed, generic)
+_SIGMA = np.array(SIGMA)
 COUNT = 16
 ROWS = 14  # the Raghavan–Roth equations
 RANK_TOL = 1e-9  # Q's eight columns are degenerate where their singular values span more than 1/RANK_TOL
@@ -61,6 +65,10 @@ for _i in range(3):
     for _j in range(3):
         _EMBED[0, 3 * _i + _j, 3 * _i + _j] = 1
         _EMBED[1, 3 * _i + _j, 3 * (_i + 1) + _j] = 1
+# a row on (1, c3, s3) ⊗ X45 (27) → its coefficients of x3^p and its two embeddings (p, e, 12): the
+# charts and the embeddings in one linear map
+_COMPANION = np.eye(24, k=12)  # [[0, I], [−M2⁻¹M0, −M2⁻¹M1]], the lower half filled per pose
+_MATRIX_POLY = np.einsum("kp,mn,enc->kmpec", H3, H45, _EMBED).reshape(27, 72)
 
 
 def _cs(psi: np.ndarray) -> np.ndarray:
@@ -75,51 +83,76 @@ def _angle(c: np.ndarray, s: np.ndarray) -> np.ndarray:
     return -1j * np.log((c + 1j * s) / np.sqrt(c * c + s * s))
 
 
+def _complex_vectors(wi: np.ndarray, vr: np.ndarray) -> np.ndarray:
+    """The complex eigenvectors from LAPACK's real form: for a pair wi[j] > 0 = −wi[j+1], columns
+    j and j + 1 are the real and imaginary parts of the vector of eigenvalue j (its conjugate is
+    eigenvalue j + 1's)."""
+    v = vr.astype(complex)
+    j = np.flatnonzero(wi > 0)
+    v[:, j] += 1j * vr[:, j + 1]
+    v[:, j + 1] = np.conj(v[:, j])
+    return v
+
+
 def eliminate(dh: np.ndarray, T: np.ndarray) -> np.ndarray | None:
     """The 16 candidate angle vectors θ (16, 6) complex of a 6R chain (dh (6, 4), T (4, 4), both in
     one length unit), before Newton; None where the elimination does not apply (see the module)."""
     P, Q = kernels.call("ik6r_equations", dh, T)
     P = P.reshape(ROWS, 27)
     P[:, 0] -= Q[:, 0]  # the constant monomial goes to the left side
-    U, sv, Vt = np.linalg.svd(Q[:, 1:])
-    if sv[-1] <= RANK_TOL * sv[0]:
+    # LAPACK directly (scipy.linalg.lapack): NumPy's wrappers cost more than these small problems
+    U, sv, Vt, info = lapack.dgesdd(Q[:, 1:])
+    if info or not sv[-1] > RANK_TOL * sv[0]:  # (NaN included)
         return None
-    E = (U[:, 8:].T @ P).reshape(6, 3, 9) @ H45  # six rows free of X12: on (1, c3, s3) ⊗ x4^i x5^j
-    C = np.einsum("kp,akn->pan", H3, E)  # (3, 6, 9): the coefficients of x3^0, x3^1, x3^2
-    M = np.concatenate([C @ _EMBED[0], C @ _EMBED[1]], axis=1)  # (3, 12, 12)
-    try:
-        A = np.linalg.solve(M[2], np.concatenate([M[0], M[1]], axis=1))
-    except np.linalg.LinAlgError:
+    # six rows free of X12, as M(x3) = Σ_p x3^p M[p] (3, 12, 12): row (e, a) is row a, times x4 if e = 1
+    M = (U[:, 8:].T @ P @ _MATRIX_POLY).reshape(6, 3, 2, 12).transpose(1, 2, 0, 3).reshape(3, 12, 12)
+    _, _, A, info = lapack.dgesv(M[2], np.concatenate([M[0], M[1]], axis=1))
+    if info:
         return None
-    K = np.zeros((24, 24))
-    K[:12, 12:] = np.eye(12)
+    K = _COMPANION.copy()
     K[12:] = -A
-    x3, vecs = np.linalg.eig(K)
+    wr, wi, _, vr, info = lapack.dgeev(K, compute_vl=0)
+    if info:
+        return None
+    x3, vecs = wr + 1j * wi, _complex_vectors(wi, vr)  # vecs[:, k] = [m; x3 m], m = x4^i x5^j (i ≤ 3, j ≤ 2)
     # the spurious eigenvalues: four at +i, four at −i
     near = np.minimum(np.abs(x3 - 1j), np.abs(x3 + 1j)) / (1 + np.abs(x3))
     order = np.argpartition(near, 8)
     spurious, keep = order[:8], order[8:]
     if np.any(near[spurious] > SPURIOUS_TOL) or np.count_nonzero(x3[spurious].imag > 0) != 4:
         return None
-    x3, vecs = x3[keep], vecs[:, keep]
+    L = (U[:, :8] / sv) @ Vt  # (14, 8): X12 (without its constant) from the 14 equations by least squares
+    return angles(x3[keep], vecs[:, keep].T, P, L, dh, T)
+
+
+def angles(x3: np.ndarray, vecs: np.ndarray, P: np.ndarray, L: np.ndarray, dh: np.ndarray, T: np.ndarray,
+           engine: str | None = None) -> np.ndarray:
+    """θ (k, 6) from k eigenpairs (x3 (k,), vecs (k, 24)) of the companion matrix: step 4 of the
+    module. In C (apair_ik6r_angles) where installed, else NumPy."""
+    native = homotopy._native() if engine in (None, "c") else None
+    if native is not None:
+        return native.ik6r_angles(x3, np.ascontiguousarray(vecs), P, L, _SIGMA, dh, T)
+    if engine == "c":
+        raise RuntimeError("engine: the compiled C kernels are not installed")
+    count = len(x3)
     # the monomial vector: the half of [v; x3 v] with the larger norm
     top = np.abs(x3) <= 1
-    V = np.where(top[None, :], vecs[:12], vecs[12:]).T.reshape(COUNT, 4, 3)  # [sol, i (x4), j (x5)]
+    V = np.where(top[:, None], vecs[:, :12], vecs[:, 12:]).reshape(count, 4, 3)  # [sol, i (x4), j (x5)]
     x4 = np.sum(np.conj(V[:, :-1, :]) * V[:, 1:, :], axis=(1, 2)) / np.sum(np.abs(V[:, :-1, :]) ** 2, axis=(1, 2))
     x5 = np.sum(np.conj(V[:, :, :-1]) * V[:, :, 1:], axis=(1, 2)) / np.sum(np.abs(V[:, :, :-1]) ** 2, axis=(1, 2))
-    psi = np.zeros((COUNT, 6), complex)
+    psi = np.zeros((count, 6), complex)
     psi[:, 2] = SIGMA[0] + 2 * np.arctan(x3)
     psi[:, 3] = SIGMA[1] + 2 * np.arctan(x4)
     psi[:, 4] = SIGMA[2] + 2 * np.arctan(x5)
     cs = _cs(psi[:, 2:5])
-    X45 = np.einsum("ki,kj->kij", cs[:, 1], cs[:, 2]).reshape(COUNT, 9)
-    rhs = (cs[:, 0, :, None] * X45[:, None, :]).reshape(COUNT, 27) @ P.T  # P(ψ3) X45: (16, 14)
-    X12 = rhs @ (U[:, :8] / sv) @ Vt  # (16, 8): X12[1:] by least squares
+    X45 = np.einsum("ki,kj->kij", cs[:, 1], cs[:, 2]).reshape(count, 9)
+    rhs = (cs[:, 0, :, None] * X45[:, None, :]).reshape(count, 27) @ P.T  # P(ψ3) X45: (k, 14)
+    X12 = rhs @ L  # (k, 8)
     # X12 = (1, c1, s1) ⊗ (1, c2, s2): index 3 c1, 6 s1, 1 c2, 2 s2 (minus one: the constant is gone)
     psi[:, 0] = _angle(X12[:, 2], X12[:, 5])
     psi[:, 1] = _angle(X12[:, 0], X12[:, 1])
     # ψ6: A_6's first column (cos ψ6, sin ψ6, 0) = R_5ᵀ … R_1ᵀ T e_x, each R_i = Rz(ψ_i)·Rx(α_i)
-    u0, u1, u2 = (np.full(COUNT, T[k, 0], complex) for k in range(3))
+    u0, u1, u2 = (np.full(count, T[k, 0], complex) for k in range(3))
     c, s = np.cos(psi[:, :5]).T, np.sin(psi[:, :5]).T
     for i in range(5):
         ca, sa = math.cos(dh[i, 1]), math.sin(dh[i, 1])
@@ -161,25 +194,8 @@ def solve(problem, T: np.ndarray) -> np.ndarray | None:
         theta = None if psi is None else -psi[:, ::-1] - problem.dh[:, 3]
     if theta is None or not np.all(np.abs(theta.imag) <= IMAG_MAX):  # (NaN included)
         return None
-    target, still = problem.target(T), np.zeros(7, complex)
-    size = np.full(COUNT, np.inf)  # each solution's last Newton step
-    done = np.zeros(COUNT, bool)
-    for _ in range(NEWTON):
-        todo = ~done
-        if not todo.any():
-            break
-        with np.errstate(all="ignore"):  # a root that runs off (to a root at infinity) fails below
-            F, dF, _ = homotopy.system(problem, theta[todo], target, still)
-            try:
-                step = np.linalg.solve(dF, F[..., None])[..., 0]
-            except np.linalg.LinAlgError:
-                return None
-        theta[todo] -= step
-        last, size[todo] = size[todo], np.max(np.abs(step), axis=1)
-        # converged, or at its rounding level: small and no longer contracting
-        done[todo] = (size[todo] <= CONVERGED) | ((size[todo] <= ACCURATE) & (size[todo] > STALL * last))
-        if not np.all(np.abs(theta.imag) <= IMAG_MAX):
-            return None
+    theta, size = homotopy.newton(problem, theta, homotopy.target_of(pose), NEWTON, CONVERGED, ACCURATE, STALL,
+                                  IMAG_MAX)
     # large |Im θ| makes the system's entries large (e^|Im θ|) and Newton stalls at its rounding
     # level; a stalled root still counts when it is far from every other root
     if not np.all(size <= ACCURATE):
