@@ -342,10 +342,11 @@ class Solver:
             except _Degenerate as exc:
                 degenerate.append(str(exc))
                 continue
+            cands = np.array(cands, complex).reshape(-1, n)
             # points where a joint's rotation part vanishes (u = ±i, isotropic) are not displacements
-            cands = [c for c in cands if np.all(np.abs(1 + c * c) > 1e-3 * (1 + np.abs(c) ** 2))]
+            cands = cands[np.all(np.abs(1 + cands * cands) > 1e-3 * (1 + np.abs(cands) ** 2), axis=1)]
             count = len(_dedupe_complex(cands)) if count_complex else None
-            real = [c for c in cands if np.all(np.abs(np.imag(c)) <= CAND_TOL * (1 + np.abs(c)))]
+            real = cands[np.all(np.abs(cands.imag) <= CAND_TOL * (1 + np.abs(cands)), axis=1)]
             q = _with_twins(self.chain, self._elimination(reverse).angles(real))
             q, err = _refine(self.chain, q, Tm, tol)
             if len(q) or not _near_reach(self.chain, Tm):
@@ -444,11 +445,11 @@ class _Elimination:
         n = self.chain.n
         return self._solve_left(target, n) if n <= 2 else self._solve_right(target, count_complex)
 
-    def angles(self, real: list) -> np.ndarray:
-        """Joint angles (k, n) in the chain's order from real parameter vectors."""
-        if not real:
+    def angles(self, real: np.ndarray) -> np.ndarray:
+        """Joint angles (k, n) in the chain's order from real parameter vectors (k, n)."""
+        if len(real) == 0:
             return np.zeros((0, self.chain.n))
-        U = np.real(np.array(real))
+        U = np.real(real)
         q = np.stack([j.theta(U[:, i]) for i, j in enumerate(self.joints)], 1)
         return q[:, ::-1] if self.reverse else q
 
@@ -503,10 +504,14 @@ class _Elimination:
                 continue
         return out
 
-    def _quadric_image(self, C: np.ndarray, weights: np.ndarray) -> np.ndarray:
-        """Coefficients (u_3^i u_4^j) of Σ_k w_k Q_k(W(u_3, u_4)) for the left half's quadrics Q_k."""
-        Q = np.tensordot(weights, self.Q, 1)
-        return np.real(_bivariate(C, C, lambda A, B: np.einsum("...a,ab,...b->...", A, Q, B)))
+    def _quadric_images(self, C: np.ndarray):
+        """Coefficients (u_3^i u_4^j) of Σ_k w_k Q_k(W(u_3, u_4)) for the left half's quadrics Q_k,
+        one per set of weights, computed when asked for (one FFT of W for all of them)."""
+        s = (2 * C.shape[0] - 1, 2 * C.shape[1] - 1)
+        F = np.fft.fft2(C, s=s, axes=(0, 1))
+        for w in (self.weights, self.weights2, self.weights3):
+            Q = np.tensordot(w, self.Q, 1)
+            yield np.real(np.fft.ifft2(np.einsum("...a,ab,...b->...", F, Q, F), axes=(-2, -1)))
 
     def _resultant_roots(self, C: np.ndarray, X: np.ndarray) -> np.ndarray:
         """Every u_3 at which two conditions on W(u_3, u_4) have a common root u_4: the rotation
@@ -515,23 +520,28 @@ class _Elimination:
         other combinations, until the resultant is not identically zero; where every pair shares
         a curve, the regular part of the first pair's pencil."""
         f = np.real(_bivariate(X, X, lambda A, B: np.einsum("...a,ab,...b->...", A, self.Qx, B)))
-        g1, g2, g3 = (self._quadric_image(C, w) for w in (self.weights, self.weights2, self.weights3))
-        tries = [(g1, g2), (g2, g3)]
+        images, g = self._quadric_images(C), []
+
+        def poly(k: int) -> np.ndarray:  # −1: f; 0, 1, 2: the quadric images, computed when first needed
+            while k >= len(g):
+                g.append(next(images))
+            return f if k < 0 else g[k]
+
+        tries = [(0, 1), (1, 2)]
         if np.abs(f).max() > 1e-12 * np.abs(X).max() ** 2 * np.abs(self.Qx).max():
-            tries = [(f, g1), (f, g2)] + tries
+            tries = [(-1, 0), (-1, 1)] + tries
         for a, b in tries:
             try:
-                return _hidden_variable(a, b, self.rng, singular_ok=False)
+                return _hidden_variable(poly(a), poly(b), self.rng, singular_ok=False)
             except _Degenerate:
                 continue
-        return _hidden_variable(*tries[0], self.rng)  # every pair shares a curve: the regular part
+        return _hidden_variable(poly(tries[0][0]), poly(tries[0][1]), self.rng)  # every pair shares a curve
 
     def _right_pairs(self, u3s: np.ndarray, C: np.ndarray, real: bool):
         """For each u_3, the u_4 where every quadric of the left half vanishes on W(u_3, u_4) (their
         common roots: complete even where f or g alone vanishes for all u_4 at that u_3); the
         pairs (r, 2) and their images W (r, 8). A u_3 at which all of them vanish for every u_4
         (a curve of candidates, never a solution of a full-rank pose) is skipped."""
-        pairs, images = [], []
         if len(u3s) == 0:
             return np.zeros((0, 2)), np.zeros((0, 8))
         Cu = np.einsum("ri,ija->rja", u3s[:, None] ** np.arange(C.shape[0]), C)  # (R, D4+1, 8)
@@ -540,17 +550,19 @@ class _Elimination:
         polys = np.zeros(outer.shape[:2] + (2 * D - 1,), dtype=outer.dtype)
         for j in range(D):
             polys[:, :, j: j + D] += outer[:, :, j, :]
-        for u3, u4s, Wc in zip(u3s, _common_roots_many(polys, self.rng), Cu):
+        owner, u4 = [np.zeros(0, int)], [np.zeros(0, complex if not real else float)]
+        for r, u4s in enumerate(_common_roots_many(polys, self.rng)):
             if u4s is None:  # every quadric vanishes for all u4 at this u3
                 continue
             if real:
                 u4s = u4s[np.abs(u4s.imag) <= CAND_TOL * (1 + np.abs(u4s))].real
-            for u4 in u4s:
-                pairs.append([u3, u4])
-                images.append((u4 ** np.arange(D)) @ Wc)
-        if not pairs:
+            owner.append(np.full(len(u4s), r))
+            u4.append(u4s)
+        owner, u4 = np.concatenate(owner), np.concatenate(u4)
+        if len(u4) == 0:
             return np.zeros((0, 2)), np.zeros((0, 8))
-        return np.array(pairs), np.array(images)
+        images = np.einsum("kj,kja->ka", u4[:, None] ** np.arange(D), Cu[owner])
+        return np.stack([u3s[owner], u4], 1), images
 
     def _solve_right(self, T: np.ndarray, count_complex: bool) -> list[np.ndarray]:
         """Candidates for 3 and 4 joints: the right part's parameters from the left half's quadrics
