@@ -585,13 +585,14 @@ def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4) -> St
             p0, sols, more = monodromy(problem, rng, progress=progress, p0=p0, known=index.rows)
             loops += more
     # every solution is carried around CHECK_LOOPS more loops: a path that cannot be tracked (far out
-    # in the complex, where digits are lost) marks a set whose missing members could hide there
+    # in the complex, where digits are lost) with any of RETRIES gammas marks a set whose missing
+    # members could hide there
     lost = 0
     for _ in range(CHECK_LOOPS):
         pa, pb = random_pose(rng), random_pose(rng)
         cur = sols
         for a, b in ((p0, pa), (pa, pb), (pb, p0)):
-            cur, status = _segment(problem, a, b, cur, rng)
+            cur, status = _segment(problem, a, b, cur, rng, retries=RETRIES)
             lost += int(np.sum((status == FAILED) | (status == TOO_LONG)))
     certified = bool(sum(c == len(sols) for c in counts) >= 2 and lost == 0)
     return StartSystem(problem.key(), p0, sols, loops, counts, certified, time.perf_counter() - t0)
