@@ -65,9 +65,9 @@ for _i in range(3):
     for _j in range(3):
         _EMBED[0, 3 * _i + _j, 3 * _i + _j] = 1
         _EMBED[1, 3 * _i + _j, 3 * (_i + 1) + _j] = 1
+_COMPANION = np.eye(24, k=12)  # [[0, I], [−M2⁻¹M0, −M2⁻¹M1]], the lower half filled per pose
 # a row on (1, c3, s3) ⊗ X45 (27) → its coefficients of x3^p and its two embeddings (p, e, 12): the
 # charts and the embeddings in one linear map
-_COMPANION = np.eye(24, k=12)  # [[0, I], [−M2⁻¹M0, −M2⁻¹M1]], the lower half filled per pose
 _MATRIX_POLY = np.einsum("kp,mn,enc->kmpec", H3, H45, _EMBED).reshape(27, 72)
 
 
@@ -107,7 +107,7 @@ def eliminate(dh: np.ndarray, T: np.ndarray) -> np.ndarray | None:
     # six rows free of X12, as M(x3) = Σ_p x3^p M[p] (3, 12, 12): row (e, a) is row a, times x4 if e = 1
     M = (U[:, 8:].T @ P @ _MATRIX_POLY).reshape(6, 3, 2, 12).transpose(1, 2, 0, 3).reshape(3, 12, 12)
     _, _, A, info = lapack.dgesv(M[2], np.concatenate([M[0], M[1]], axis=1))
-    if info:
+    if info or not np.isfinite(A).all():  # M2 singular
         return None
     K = _COMPANION.copy()
     K[12:] = -A
