@@ -587,6 +587,12 @@ class _Elimination:
 
 
 # ----------------------------------------------------------------------------- helpers
+def _close_pairs(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Indices i < j of the rows of x (r, m) that agree to CAND_TOL in every entry."""
+    close = np.all(np.abs(x[:, None] - x[None]) <= CAND_TOL * (1 + np.abs(x[:, None])), axis=-1)
+    return np.nonzero(np.triu(close, 1))
+
+
 def _with_means(u: np.ndarray) -> np.ndarray:
     """The roots u (r,) and the mean of every two that agree to CAND_TOL: a double root comes out
     as two simple roots (or a complex pair) about √ε apart, too inaccurate for what is solved from
@@ -594,9 +600,7 @@ def _with_means(u: np.ndarray) -> np.ndarray:
     coefficients). At a pose where the left half's surface crosses itself (an A-pair at ±π) the
     resultant has such a double root. The roots themselves are kept, and means at the isotropic
     points u = ±i (never a displacement) are not added."""
-    if len(u) < 2:
-        return u
-    i, j = np.nonzero(np.triu(np.abs(u[:, None] - u[None]) <= CAND_TOL * (1 + np.abs(u[:, None])), 1))
+    i, j = _close_pairs(u[:, None])
     means = (u[i] + u[j]) / 2
     means = means[np.abs(1 + means * means) > 1e-3 * (1 + np.abs(means) ** 2)]
     return np.concatenate([u, means]) if len(means) else u
@@ -608,11 +612,7 @@ def _with_cluster_means(pairs: np.ndarray, images: np.ndarray, C: np.ndarray):
     about √ε apart, too inaccurate for the left half, while their mean is accurate to about ε.
     Candidates are kept as they are, so two close genuine solutions are not merged (verification
     and deduplication decide)."""
-    if len(pairs) < 2:
-        return pairs, images
-    diff = np.abs(pairs[:, None, :] - pairs[None, :, :])
-    close = np.all(diff <= CAND_TOL * (1 + np.abs(pairs[:, None, :])), axis=-1)
-    i, j = np.nonzero(np.triu(close, 1))
+    i, j = _close_pairs(pairs)
     if len(i) == 0:
         return pairs, images
     means = (pairs[i] + pairs[j]) / 2
@@ -789,17 +789,6 @@ _LAST_ROW, _EYE3 = np.array([0.0, 0, 0, 1]), np.eye(3)
 def _check_matrix(T: np.ndarray) -> np.ndarray:
     """T (4, 4) or a stack (..., 4, 4) of rigid transforms, checked at once: last row [0, 0, 0, 1],
     rotation part orthonormal with det +1."""
-    if T.shape == (4, 4):  # one pose (the common case): the same tests on Python floats, far cheaper
-        m = T.tolist()
-        if not all(abs(a - b) <= 1e-12 + 1e-5 * b for a, b in zip(m[3], (0.0, 0.0, 0.0, 1.0))):
-            raise ValueError(f"T: last row must be [0, 0, 0, 1], got {m[3]}")
-        c = [[m[0][j], m[1][j], m[2][j]] for j in range(3)]  # the rotation's columns
-        det = (c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0])
-               + c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0]))
-        if not (all(abs(sum(a * b for a, b in zip(c[i], c[j])) - (i == j)) <= 1e-9 for i in range(3) for j in range(3))
-                and det >= 0):
-            raise ValueError("T: the rotation part is not a proper rotation (orthonormal, det +1)")
-        return T
     rows = T[..., 3, :].reshape(-1, 4)
     bad = np.flatnonzero(~np.all(np.abs(rows - _LAST_ROW) <= 1e-12 + 1e-5 * _LAST_ROW, axis=1))
     if len(bad):
