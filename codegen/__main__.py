@@ -18,13 +18,14 @@ from . import derivation
 from .emitter import Emitter, OutputError, lower, render_polynomials, write
 
 DERIVATIONS = ("apair_collisions", "apair_pair", "apair_dynamics", "chain_kinematics", "chain_dynamics",
-               "chain_variety", "chain_ik", "chain_ik6r")
+               "chain_variety", "chain_ik", "chain_ik6r", "chain_ik1a5r")
 ROOT = Path(__file__).resolve().parent.parent
 # Rough cost of each job on one core [s], for scheduling the longest first.
 COST = {("chain_dynamics", 6): 40, ("chain_dynamics", 5): 28, ("chain_dynamics", 4): 20,
         ("chain_dynamics", "check"): 15, ("apair_dynamics", None): 9, ("apair_pair", None): 8,
         ("chain_variety", None): 7, ("chain_dynamics", 3): 6, ("chain_kinematics", None): 6, ("chain_ik", None): 20,
-        ("chain_ik6r", None): 3}
+        ("chain_ik6r", None): 3,
+        ("chain_ik1a5r", 1): 12, ("chain_ik1a5r", 2): 12, ("chain_ik1a5r", 3): 12}
 
 
 def jobs(names) -> list[tuple[str, object]]:

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 9e7215679404dceb
+Content hash: 7b6f674dd6753490
 """

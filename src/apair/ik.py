@@ -362,15 +362,18 @@ class Solver:
 
     def _solve_homotopy(self, T, tol: float) -> Solution:
         """n = 5, 6: R-chains by the 6R elimination (apair.ik6r) where it certifies its 16
-        solutions; otherwise every start solution tracked to T (apair.homotopy). Real solutions
-        verified."""
-        from . import homotopy, ik6r
+        solutions, chains with one A-pair by theirs (apair.ik1a5r, 48); otherwise every start
+        solution tracked to T (apair.homotopy). Real solutions verified."""
+        from . import homotopy, ik1a5r, ik6r
 
         Tm = _pose_matrix(T)
         if self._problem is None:
             self._problem = homotopy.Problem.of(self.chain)
         problem = self._problem
-        theta = ik6r.solve(problem, Tm) if ik6r.applies(problem) else None
+        theta = None
+        for route in (ik6r, ik1a5r):
+            if route.applies(problem):
+                theta = route.solve(problem, Tm)
         if theta is not None:
             theta, complete, method = homotopy.own(problem, theta), True, "elimination"
         else:

@@ -192,17 +192,31 @@ def solve(problem, T: np.ndarray) -> np.ndarray | None:
     if theta is None:  # e.g. the first two axes parallel: read the chain from its end
         psi = eliminate(*reversed_chain(problem.dh, pose))
         theta = None if psi is None else -psi[:, ::-1] - problem.dh[:, 3]
-    if theta is None or not np.all(np.abs(theta.imag) <= IMAG_MAX):  # (NaN included)
+    return None if theta is None else verified(problem, theta, pose, COUNT)
+
+
+def verified(problem, theta: np.ndarray, pose: np.ndarray, count: int, must: np.ndarray | None = None
+             ) -> np.ndarray | None:
+    """The `count` candidates θ (count, 6) of an elimination after Newton on the homotopy system
+    at the pose, or None unless every candidate in `must` (default: all) converged and the
+    converged ones are distinct (then the set is complete where `count` is the pattern's generic
+    count). A candidate outside `must` that does not converge is returned as it came."""
+    must = np.ones(count, bool) if must is None else must
+    if not np.all(np.abs(theta[must].imag) <= IMAG_MAX):  # (NaN included)
         return None
-    theta, size = homotopy.newton(problem, theta, homotopy.target_of(pose), NEWTON, CONVERGED, ACCURATE, STALL,
-                                  IMAG_MAX)
+    refined, size = homotopy.newton(problem, theta, homotopy.target_of(pose), NEWTON, CONVERGED, ACCURATE, STALL,
+                                    IMAG_MAX)
     # large |Im θ| makes the system's entries large (e^|Im θ|) and Newton stalls at its rounding
     # level; a stalled root still counts when it is far from every other root
-    if not np.all(size <= ACCURATE):
+    ok = size <= ACCURATE
+    if not np.all(ok[must]):
         return None
-    # distinct: |e^{iθ} − e^{iθ'}| over the mean modulus is |θ − θ'| (mod 2π) to first order
-    z = np.exp(1j * theta)
+    # distinct: |e^{iθ} − e^{iθ'}| over the mean modulus is |θ − θ'| (mod 2π; an A-pair's half
+    # angle, mod 4π) to first order
+    z = np.exp(1j * refined[ok] * np.where(problem.kind == 1, 0.5, 1.0))
     m = np.abs(z)
     gap = np.max(np.abs(z[:, None] - z[None]) / (0.5 * (m[:, None] + m[None])), axis=-1)
-    gap[np.diag_indices(COUNT)] = np.inf
-    return theta if gap.min() > max(SAME, SEPARATION * size.max()) else None
+    gap[np.diag_indices(len(z))] = np.inf
+    if len(z) > 1 and not gap.min() > max(SAME, SEPARATION * size[ok].max()):
+        return None
+    return np.where(ok[:, None], refined, theta)
