@@ -12,20 +12,25 @@ parameter is shifted by a random angle (a Möbius substitution) so that no solut
   to P_2(u_2) (polynomials in u_2): two univariate problems.
 - 3 and 4 joints: the left half's (joints 1, 2) constraint variety, evaluated on the right part's
   parametrised image W(u_3, u_4) = T·(A_3A_4)~, must vanish. Its quadrics are found by SVD on
-  sampled points of the half (`_half_quadrics`); the one quadric in x alone (the spherical
-  two-joint condition) divided by its (1 + u²) factors gives f(u_3, u_4) of bidegree (4, 4), a
-  random combination of all quadrics gives g of bidegree (8, 8). Their resultant in u_4 (degree 64
-  in u_3) is never expanded: the Sylvester matrix in u_4, whose rows have degree 4 or 8 in u_3, is
-  linearised by rows into a 64 × 64 eigenvalue problem. Each real eigenvalue u_3 gives the common
-  real roots u_4 of f and g; a pair is kept if every quadric of the left half vanishes on its
-  image, and the left half is then solved for W(u_3, u_4) as above.
+  sampled points of the half (`_half_quadrics`). Their images Q(W(u_3, u_4)) have bidegree
+  (8, 8), less the factors 1 + u² they carry at every pose (found once per design and divided
+  out): the quadric in x alone (the spherical two-joint condition) gives f of bidegree (4, 4), a
+  quadric without a yy block g of bidegree (6, 6) (for A-pairs), random combinations (8, 8).
+  The resultant in u_4 of f and g (degree 48 in u_3) is never expanded: the Sylvester matrix in
+  u_4, whose rows have degree 4 or 6 in u_3, is linearised by rows into a 48 × 48 eigenvalue
+  problem. At each real eigenvalue u_3 the Sylvester matrix's null vector (1, u_4, u_4², …)
+  gives u_4, and the pair is kept if every quadric of the left half vanishes on its image
+  (`_screen`; undecided ones get the common roots u_4 of all quadrics, `_right_pairs`); the left
+  half is then solved for W(u_3, u_4) as above.
 
 Special designs (twists of 0 and 90°, zero lengths: what robots are built from) make parts of this
 degenerate, and each has its own remedy:
 - the rotation condition holds on the whole image (parallel axes, as in examples/4a_chain.toml),
-  or f and g share a curve: other random combinations of the quadrics take their place; where
-  every pair shares a curve, the u_3 are the eigenvalues of the singular pencil's regular part
-  (a random rank completion, `_regular_eigenvalues`);
+  or f and g share a curve: other combinations of the quadrics take their place, the pair with
+  the smallest resultant first (parallel axes give every image more factors 1 + u²: the
+  example's pair has bidegrees (4, 4), a 32 × 32 problem; undivided, the factors made every
+  pencil singular); where every pair shares a curve, the u_3 are the eigenvalues of the singular
+  pencil's regular part (a random rank completion, `_regular_eigenvalues`);
 - at some u_3 every u_4 satisfies f (or g): each u_3 gets the common roots u_4 of *all* the
   left half's quadrics (`_right_pairs`), not of f and g alone;
 - joints 1 and 2 on one axis (a_1 = α_1 = 0): u_1 and u_2 come together from a bivariate
@@ -53,10 +58,11 @@ from functools import lru_cache
 
 import numpy as np
 import scipy.linalg
+from scipy.linalg import lapack
 
 from . import _validate as V
 from .homotopy import scale_of
-from .study import _qmul, conjugate, from_matrix, multiply, normalise, to_matrix
+from .study import conjugate, from_matrix, multiply, normalise, to_matrix
 
 SEED = 46  # fixed: the parameter shifts and random combinations are reproducible
 OUTSIDE = [1, 2, 5, 6]  # components that vanish on the pair subalgebra
@@ -130,16 +136,6 @@ def _mobius(coeffs: np.ndarray, tau: float) -> np.ndarray:
     return out
 
 
-def _bivariate(a: np.ndarray, b: np.ndarray, form) -> np.ndarray:
-    """Coefficients (i, j) of form(A(u, v), B(u, v)) for polynomial vector fields given by
-    coefficients a, b (Du+1, Dv+1, ...) when `form` is bilinear: by FFT on a grid of unit roots."""
-    nu = a.shape[0] + b.shape[0] - 1
-    nv = a.shape[1] + b.shape[1] - 1
-    A = np.fft.fft2(a, s=(nu, nv), axes=(0, 1))
-    B = np.fft.fft2(b, s=(nu, nv), axes=(0, 1))
-    return np.fft.ifft2(form(A, B), axes=(-2, -1))
-
-
 @lru_cache(maxsize=None)
 def _quartic() -> np.ndarray:
     """(5, 8, 2): the coefficient of u^m h^k in component j of the sinusoidal pair's Study point,
@@ -207,13 +203,11 @@ def _trans(axis: int, dist: float) -> np.ndarray:
 
 @dataclass
 class _Joint:
-    """Joint i in a shifted parameter u: P(u) (D+1, 8); the x-part of A(u) = P(u)·K divided by
-    (1 + u²) where it has that factor (Dx+1, 4); the constant K and K⁻¹; and the map u → θ."""
+    """Joint i in a shifted parameter u: P(u) (D+1, 8); the constant K and K⁻¹; and the map u → θ."""
 
     kind: str
     delta: float
     P: np.ndarray
-    xhat: np.ndarray
     K: np.ndarray
     Kinv: np.ndarray
     A: np.ndarray = field(init=False)
@@ -247,14 +241,7 @@ def _link(chain, i: int, scale: float) -> np.ndarray:
 
 
 def _make_joint(kind: str, delta: float, P: np.ndarray, K: np.ndarray) -> _Joint:
-    x = P[:, :4]
-    if kind != "revolute":  # x carries the factor (1 + u²) (up to a constant after the shift)
-        Pn = np.polynomial.polynomial
-        parts = [Pn.polydiv(x[:, j], [1.0, 0.0, 1.0]) for j in range(4)]
-        if max(np.abs(r).max() for _, r in parts) > 1e-12 * np.abs(x).max():
-            raise AssertionError("the pair's rotation part lost its (1 + u^2) factor")
-        x = np.stack([np.pad(q, (0, 3 - len(q))) for q, _ in parts], 1)
-    return _Joint(kind, delta, P, _qmul(x, K[:4]), K, conjugate(K))
+    return _Joint(kind, delta, P, K, conjugate(K))
 
 
 def _chain_joints(chain, scale: float, deltas, reverse: bool):
@@ -422,16 +409,23 @@ class _Elimination:
         if n == 4:
             j3, j4 = self.joints[2:]
             self.image = conjugate(multiply(j3.A[:, None, :], j4.A[None, :, :]))
-            self.ximage = _qconj(_qmul(j3.xhat[:, None, :], j4.xhat[None, :, :]))
         if n >= 3:
             Q, Qx = self._half_quadrics()
             if len(Qx) == 0:
                 raise AssertionError("no quadric in x vanishes on the rotations of a two-joint chain")
             self.Q = Q
             self.Qx = np.tensordot(self.rng.standard_normal(len(Qx)), Qx, 1)
-            self.weights = self.rng.standard_normal(len(Q))
-            self.weights2 = self.rng.standard_normal(len(Q))
-            self.weights3 = self.rng.standard_normal(len(Q))
+            Qx8 = np.zeros((8, 8))
+            Qx8[:4, :4] = self.Qx
+            combinations = [Qx8] + list(np.tensordot(self.rng.standard_normal((3, len(Q))), Q, 1))
+            xy = _without_yy(Q, Qx8)
+            self.combinations = np.array(combinations + ([xy] if xy is not None else []))  # (4 or 5, 8, 8)
+        if n == 4:  # the factors 1 + u² of the images at a random pose (not on the chain's image)
+            x, y = self.rng.standard_normal((2, 4))
+            x /= np.linalg.norm(x)
+            pose = np.concatenate([x, y - (x @ y) * x])  # on the Study quadric
+            images = self._quadric_images(self.image @ _left(pose).T)
+            self.factors = [_isotropic_factors(g) for g in images]
 
     def _half_quadrics(self):
         """Quadrics through the left half's poses (all, and in x alone) by SVD on sampled points."""
@@ -507,38 +501,73 @@ class _Elimination:
                 continue
         return out
 
-    def _quadric_images(self, C: np.ndarray):
-        """Coefficients (u_3^i u_4^j) of Σ_k w_k Q_k(W(u_3, u_4)) for the left half's quadrics Q_k,
-        one per set of weights, computed when asked for (one FFT of W for all of them)."""
+    def _quadric_images(self, C: np.ndarray, factors=None) -> list[np.ndarray]:
+        """Coefficients (u_3^i u_4^j) of Q(W(u_3, u_4)) for the rotation quadric Qx (first: f), three
+        random combinations Q of the left half's quadrics and the one without a yy block (last,
+        where there is one), from one FFT of W, each divided by
+        the factors 1 + u² it has at every pose (`factors`, found once per design: f has two of
+        each at least, since W's rotation part carries (1 + u_3²)(1 + u_4²))."""
         s = (2 * C.shape[0] - 1, 2 * C.shape[1] - 1)
-        F = np.fft.fft2(C, s=s, axes=(0, 1))
-        for w in (self.weights, self.weights2, self.weights3):
-            Q = np.tensordot(w, self.Q, 1)
-            yield np.real(np.fft.ifft2(np.einsum("...a,ab,...b->...", F, Q, F), axes=(-2, -1)))
+        F = np.fft.fft2(C, s=s, axes=(0, 1)).reshape(-1, 8)
+        values = np.einsum("qpb,pb->qp", F @ self.combinations, F)  # (q, s0·s1)
+        images = np.real(np.fft.ifft2(values.reshape((-1,) + s), axes=(-2, -1)))
+        if factors is None:
+            return images
+        return [_divided(g, k) for g, k in zip(images, factors)]
 
-    def _resultant_roots(self, C: np.ndarray, X: np.ndarray) -> np.ndarray:
+    def _resultant_roots(self, C: np.ndarray):
         """Every u_3 at which two conditions on W(u_3, u_4) have a common root u_4: the rotation
-        condition f (bidegree (4, 4)) with a random combination g of the quadrics, else (where f
-        vanishes on the whole image, or f and g share a curve, as special designs make them)
-        other combinations, until the resultant is not identically zero; where every pair shares
-        a curve, the regular part of the first pair's pencil."""
-        f = np.real(_bivariate(X, X, lambda A, B: np.einsum("...a,ab,...b->...", A, self.Qx, B)))
-        images, g = self._quadric_images(C), []
+        condition f (bidegree (4, 4)) with a combination g of the quadrics (the one without a yy
+        block first: bidegree (6, 6), 48 roots), else (where f vanishes on the whole image, or f
+        and g share a curve, as special designs make them) other combinations, until the
+        resultant is not identically zero; where every pair shares a curve, the regular part of
+        the first pair's pencil. The pair with the fewest roots is tried first (special designs
+        give the images more factors 1 + u²: two parallel axes halve their bidegrees). Returns
+        the roots and the pair eliminated (None for a singular pencil's regular part)."""
+        f, *g = self._quadric_images(C, self.factors)
 
-        def poly(k: int) -> np.ndarray:  # −1: f; 0, 1, 2: the quadric images, computed when first needed
-            while k >= len(g):
-                g.append(next(images))
+        def poly(k: int) -> np.ndarray:  # −1: f; 0, 1, 2: random combinations; 3: without yy
             return f if k < 0 else g[k]
 
         tries = [(0, 1), (1, 2)]
-        if np.abs(f).max() > 1e-12 * np.abs(X).max() ** 2 * np.abs(self.Qx).max():
-            tries = [(-1, 0), (-1, 1)] + tries
+        if np.abs(f).max() > 1e-12 * np.abs(C).max() ** 2 * np.abs(self.Qx).max():
+            tries = [(-1, k) for k in range(len(g))] + tries
+        tries.sort(key=lambda ab: _bezout(poly(ab[0]), poly(ab[1])))
         for a, b in tries:
             try:
-                return _hidden_variable(poly(a), poly(b), self.rng, singular_ok=False)
+                return _hidden_variable(poly(a), poly(b), self.rng, singular_ok=False), (poly(a), poly(b))
             except _Degenerate:
                 continue
-        return _hidden_variable(poly(tries[0][0]), poly(tries[0][1]), self.rng)  # every pair shares a curve
+        # every pair shares a curve
+        return _hidden_variable(poly(tries[0][0]), poly(tries[0][1]), self.rng), None
+
+    def _screen(self, u3s: np.ndarray, pair, C: np.ndarray):
+        """The real u_3 sorted by two steps of inverse iteration: the Sylvester matrix of the
+        eliminated pair `pair` is singular at each u_3, and where its null vector comes out as
+        (1, u_4, u_4², …) (one common root u_4), the left half's quadrics on W(u_3, u_4) accept the
+        pair (relative residual ≤ 1e-8) or reject u_3 (> 1e-4: most of the resultant's roots are
+        not common roots of the other quadrics). Returns the accepted pairs (r, 2), their images
+        (r, 8), and the u_3 left undecided (no such null vector, or a residual in between) for
+        _right_pairs."""
+        none = np.zeros((0, 2)), np.zeros((0, 8)), u3s
+        if pair is None or len(u3s) == 0 or np.iscomplexobj(C) or np.iscomplexobj(pair[0]):
+            return none
+        S = _sylvester_at(*pair, u3s)
+        x = np.broadcast_to(_PROBE[:S.shape[1], None], (len(S), S.shape[1], 1))
+        try:
+            for _ in range(2):
+                x = np.linalg.solve(S, x)
+                x /= np.linalg.norm(x, axis=1, keepdims=True)
+        except np.linalg.LinAlgError:  # exactly singular somewhere
+            return none
+        x = x[:, :, 0]
+        u4 = np.sum(x[:, :-1] * x[:, 1:], axis=1) / np.maximum(np.sum(x[:, :-1] ** 2, axis=1), 1e-300)
+        vandermonde = np.linalg.norm(x[:, 1:] - u4[:, None] * x[:, :-1], axis=1) <= 1e-8
+        W = np.einsum("ri,ija->rja", u3s[:, None] ** np.arange(C.shape[0]), C)
+        W = np.einsum("rj,rja->ra", u4[:, None] ** np.arange(C.shape[1]), W)
+        rel = np.abs(np.einsum("ra,kab,rb->rk", W, self.Q, W)).max(axis=1) / np.maximum(np.sum(W * W, axis=1), 1e-300)
+        accept, reject = vandermonde & (rel <= 1e-8), vandermonde & ~(rel <= 1e-4)
+        return np.stack([u3s[accept], u4[accept]], 1), W[accept], u3s[~(accept | reject)]
 
     def _right_pairs(self, u3s: np.ndarray, C: np.ndarray, real: bool):
         """For each u_3, the u_4 where every quadric of the left half vanishes on W(u_3, u_4) (their
@@ -548,11 +577,9 @@ class _Elimination:
         if len(u3s) == 0:
             return np.zeros((0, 2)), np.zeros((0, 8))
         Cu = np.einsum("ri,ija->rja", u3s[:, None] ** np.arange(C.shape[0]), C)  # (R, D4+1, 8)
-        outer = np.einsum("rja,kab,rlb->rkjl", Cu, self.Q, Cu)
+        outer = (Cu[:, None] @ self.Q) @ np.swapaxes(Cu, 1, 2)[:, None]  # (R, k, D4+1, D4+1)
         D = Cu.shape[1]
-        polys = np.zeros(outer.shape[:2] + (2 * D - 1,), dtype=outer.dtype)
-        for j in range(D):
-            polys[:, :, j: j + D] += outer[:, :, j, :]
+        polys = outer.reshape(outer.shape[:2] + (D * D,)) @ _product_map(D, D)
         owner, u4 = [np.zeros(0, int)], [np.zeros(0, complex if not real else float)]
         for r, u4s in enumerate(_common_roots_many(polys, self.rng)):
             if u4s is None:  # every quadric vanishes for all u4 at this u3
@@ -574,14 +601,20 @@ class _Elimination:
         C = self.image @ LT.T
         if self.chain.n == 3:
             G = np.einsum("ma,qab,kb->qmk", C, self.Q, C)
-            G = np.stack([_antidiagonal_sums(g) for g in G])
+            G = G.reshape(len(G), -1) @ _product_map(*G.shape[1:])
             rights = [np.array([u3]) for u3 in _common_roots(G, self.rng)]
             images = [(r[0] ** np.arange(len(C))) @ C for r in rights]
         else:
-            u3s = _with_means(self._resultant_roots(C, self.ximage @ LT[:4, :4].T))
-            if not count_complex:
+            u3s, pair = self._resultant_roots(C)
+            u3s = _with_means(u3s)
+            if count_complex:
+                rights, images = self._right_pairs(u3s, C, real=False)
+            else:
                 u3s = u3s[np.abs(u3s.imag) <= CAND_TOL * (1 + np.abs(u3s))].real
-            rights, images = self._right_pairs(u3s, C, real=not count_complex)
+                rights, images, rest = self._screen(u3s, pair, C)
+                if len(rest):
+                    more, more_images = self._right_pairs(rest, C, real=True)
+                    rights, images = np.concatenate([rights, more]), np.concatenate([images, more_images])
             rights, images = _with_cluster_means(rights, images, C)
         out = []
         for right, lefts in zip(rights, self._solve_left_many(np.asarray(images).reshape(-1, 8))):
@@ -624,14 +657,19 @@ def _with_cluster_means(pairs: np.ndarray, images: np.ndarray, C: np.ndarray):
     return np.concatenate([pairs, means]), np.concatenate([images, extra])
 
 
+_EYE8 = np.eye(8)
+_LEFT = np.stack([multiply(e, _EYE8).T for e in _EYE8])  # _LEFT[a] @ v = e_a·v
+_RIGHT = np.stack([multiply(_EYE8, e).T for e in _EYE8])  # _RIGHT[a] @ v = v·e_a
+
+
 def _left(p: np.ndarray) -> np.ndarray:
     """The 8×8 matrix of v ↦ p·v (Study product)."""
-    return multiply(p, np.eye(8)).T
+    return np.tensordot(p, _LEFT, 1)
 
 
 def _right(p: np.ndarray) -> np.ndarray:
     """The 8×8 matrix of v ↦ v·p."""
-    return multiply(np.eye(8), p).T
+    return np.tensordot(p, _RIGHT, 1)
 
 
 _PAIRS = np.triu_indices(8, 1)
@@ -652,8 +690,28 @@ def _eval(coeffs: np.ndarray, u: np.ndarray) -> np.ndarray:
     return np.einsum("m...,rm->r...", coeffs, np.asarray(u)[:, None] ** np.arange(len(coeffs)))
 
 
-def _qconj(x):
-    return x * np.array([1.0, -1.0, -1.0, -1.0])
+def _without_yy(Q: np.ndarray, Qx8: np.ndarray) -> np.ndarray | None:
+    """A quadric of the span of Q (k, 8, 8) without a yy block, orthogonal (Frobenius) to the
+    rotation quadric Qx8 and to the Study quadric x·y (both are in that subspace: the Study
+    quadric vanishes on every image, and a large Qx part would make its image nearly a
+    multiple of f, the resultant's roots inaccurate); None where there is no such quadric.
+    Its image carries the factor (1 + u_3²)(1 + u_4²), so it has bidegree (6, 6), not (8, 8),
+    and its resultant with f has 48 roots, not 64."""
+    _, sv, Vt = np.linalg.svd(Q[:, 4:, 4:].reshape(len(Q), -1).T)
+    sv = np.concatenate([sv, np.zeros(len(Q) - len(sv))])
+    null = Vt[sv <= 1e-10 * max(sv[0], 1e-300)]
+    if len(null) == 0:
+        return None
+    basis = np.tensordot(null, Q, 1).reshape(len(null), -1).T  # (64, m)
+    study = np.zeros((8, 8))
+    study[:4, 4:] = study[4:, :4] = np.eye(4)
+    known = np.stack([Qx8.ravel(), study.ravel()], 1)
+    _, sv, Vt = np.linalg.svd(known.T @ basis)
+    sv = np.concatenate([sv, np.zeros(basis.shape[1] - len(sv))])
+    if sv[-1] > 1e-8 * max(sv[0], 1e-300):  # every combination has a Qx or Study part
+        return None
+    xy = (basis @ Vt[-1]).reshape(8, 8)
+    return xy / np.linalg.norm(xy)
 
 
 def _quadric_forms(pts: np.ndarray) -> np.ndarray:
@@ -669,12 +727,79 @@ def _quadric_forms(pts: np.ndarray) -> np.ndarray:
     return (Q + np.swapaxes(Q, 1, 2)) / 2
 
 
-def _antidiagonal_sums(M: np.ndarray) -> np.ndarray:
-    """Coefficients of the product of two polynomials from their outer product (m, k) → m + k."""
-    out = np.zeros(M.shape[0] + M.shape[1] - 1, dtype=M.dtype)
-    for m in range(M.shape[0]):
-        out[m: m + M.shape[1]] += M[m]
+def _isotropic_factors(p: np.ndarray) -> tuple[int, int]:
+    """How often a real bivariate polynomial (coefficients [i, j] of u^i v^j) has the factors
+    1 + u² and 1 + v²: they vanish at the isotropic parameters ±i (never a displacement), and
+    where the quadrics of a special design (parallel axes) all have them they are common roots
+    for every v, which makes the resultant vanish identically."""
+    counts = []
+    for axis in (0, 1):
+        q, m = np.moveaxis(p, axis, 0), 0
+        while q.shape[0] > 2:
+            quot = _isotropic_division(q.shape[0] - 1, 1) @ q.reshape(q.shape[0], -1)
+            rem = q.reshape(q.shape[0], -1) - _isotropic_product(quot.shape[0] - 1) @ quot
+            if not np.abs(rem).max() <= 1e-11 * np.abs(q).max():
+                break
+            q, m = quot.reshape((-1,) + q.shape[1:]), m + 1
+        counts.append(m)
+    return counts[0], counts[1]
+
+
+def _divided(p: np.ndarray, factors: tuple[int, int]) -> np.ndarray:
+    """p (as in _isotropic_factors) divided by (1 + u²)^a (1 + v²)^b, factors = (a, b)."""
+    a, b = factors
+    return _isotropic_division(p.shape[0] - 1, a) @ p @ _isotropic_division(p.shape[1] - 1, b).T
+
+
+@lru_cache(maxsize=None)
+def _isotropic_division(d: int, m: int) -> np.ndarray:
+    """The matrix ((d − 2m + 1) × (d + 1)) of p ↦ the quotient of p (degree d) by (1 + u²)^m: the
+    recurrence quot_k = p_k − quot_{k−2}, m times."""
+    M = np.eye(d + 1)
+    for _ in range(m):
+        div = np.zeros((M.shape[0] - 2, M.shape[0]))
+        for k in range(M.shape[0] - 2):
+            div[k, k::-2] = (-1.0) ** np.arange(k // 2 + 1)
+        M = div @ M
+    return M
+
+
+@lru_cache(maxsize=None)
+def _isotropic_product(d: int) -> np.ndarray:
+    """The matrix ((d + 3) × (d + 1)) of q ↦ (1 + u²)·q for q of degree d."""
+    return np.eye(d + 3, d + 1) + np.eye(d + 3, d + 1, -2)
+
+
+def _bezout(f: np.ndarray, g: np.ndarray) -> int:
+    """The number of common zeros in P¹ × P¹ of two bivariate polynomials (their bidegrees)."""
+    return (f.shape[0] - 1) * (g.shape[1] - 1) + (f.shape[1] - 1) * (g.shape[0] - 1)
+
+
+@lru_cache(maxsize=None)
+def _product_map(m: int, k: int) -> np.ndarray:
+    """(m·k, m + k − 1): the coefficients of a product of two polynomials from their outer
+    product (m, k), flattened."""
+    i, j = np.divmod(np.arange(m * k), k)
+    out = np.zeros((m * k, m + k - 1))
+    out[np.arange(m * k), i + j] = 1.0
     return out
+
+
+def _sylvester_at(f: np.ndarray, g: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """(R, N, N), N = f's plus g's degree in v: the Sylvester matrices in v of f(u, v) and g(u, v)
+    at each u (R,) (coefficients [i, j] of u^i v^j), rows v^r f then v^r g."""
+    fu = (u[:, None] ** np.arange(f.shape[0])) @ f
+    gu = (u[:, None] ** np.arange(g.shape[0])) @ g
+    df, dg = f.shape[1] - 1, g.shape[1] - 1
+    S = np.zeros((len(u), df + dg, df + dg), fu.dtype)
+    for r in range(dg):
+        S[:, r, r: r + df + 1] = fu
+    for r in range(df):
+        S[:, dg + r, r: r + dg + 1] = gu
+    return S
+
+
+_PROBE = np.random.default_rng(SEED).standard_normal(64)  # right-hand side of the inverse iterations
 
 
 @lru_cache(maxsize=None)
@@ -723,9 +848,18 @@ def _hidden_variable(f: np.ndarray, g: np.ndarray, rng, singular_ok: bool = True
         if not singular_ok:
             raise _Degenerate("f and g have a common factor")
         return _regular_eigenvalues(A, B, deficit, rng)
-    lead = B[size - N:, [lo + d - 1 for lo, d in blocks]]  # B is I plus this block, permuted
-    if np.linalg.cond(lead) < 1e10:
-        return np.linalg.eigvals(np.linalg.solve(B, A))
+    lead_cols = [lo + d - 1 for lo, d in blocks]
+    lead = B[size - N:, lead_cols]  # B is I plus this block, permuted
+    if np.linalg.cond(lead) < 1e10:  # B⁻¹A: the shift rows as they are, lead⁻¹ times the last N rows
+        M = np.zeros((size, size), dtype)
+        M[shift_cols, shift_cols + 1] = 1.0
+        M[lead_cols] = np.linalg.solve(lead, A[size - N:])
+        if dtype == complex:
+            return np.linalg.eigvals(M)
+        wr, wi, _, _, info = lapack.dgeev(M, compute_vl=0, compute_vr=0)  # NumPy's wrapper costs more
+        if info == 0:
+            return wr + 1j * wi
+        return np.linalg.eigvals(M)
     w = scipy.linalg.eigvals(A, B)
     return w[np.isfinite(w)]
 
