@@ -125,6 +125,39 @@ def _common_roots_many(polys: np.ndarray, rng: np.random.Generator) -> list:
     return out
 
 
+def _shifted(polys: np.ndarray, m: int) -> np.ndarray:
+    """(R, k(m+1), D+m+1): the polynomials (R, k, D+1) times u^0 … u^m, one row each."""
+    R, k, d = polys.shape
+    out = np.zeros((R, m + 1, k, d + m), polys.dtype)
+    for s in range(m + 1):
+        out[:, s, :, s: s + d] = polys
+    return out.reshape(R, (m + 1) * k, d + m)
+
+
+def _unique_roots(M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For systems M (R, k, D+1) of polynomials (ascending coefficients): (u (R,), ok (R,)), ok
+    where the coefficient matrix has rank D and its null vector is (1, u, …, u^D) of a root that
+    passes the residual test. A common root puts its vector in the null space, so ok means
+    exactly one common root (the others go to the eigenvalues: _common_roots_many)."""
+    D = M.shape[2] - 1
+    if len(M) == 0 or D < 1 or M.shape[1] < D:
+        return np.zeros(len(M), M.dtype), np.zeros(len(M), bool)
+    _, sv, Vt = np.linalg.svd(M)
+    v = Vt[:, -1].conj()
+    u = np.sum(v[:, :-1].conj() * v[:, 1:], axis=1) / np.maximum(np.sum(np.abs(v[:, :-1]) ** 2, axis=1), 1e-300)
+    vandermonde = np.linalg.norm(v[:, 1:] - u[:, None] * v[:, :-1], axis=1) <= 1e-8
+    ok = (sv[:, D - 1] > 1e-6 * sv[:, 0]) & vandermonde & (_relres_many(M, u) <= ROOT_RTOL)
+    return u, ok
+
+
+def _relres_many(M: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """_relres of each system M[r] (R, k, D+1) at its own point u[r]."""
+    pw = u[:, None] ** np.arange(M.shape[2])
+    num = np.abs(np.einsum("rm,rkm->rk", pw, M)).max(axis=1)
+    den = np.einsum("rm,rm->r", np.abs(pw), np.abs(M).max(axis=1))
+    return num / np.maximum(den, 1e-300)
+
+
 def _mobius(coeffs: np.ndarray, tau: float) -> np.ndarray:
     """(D+1, ...) coefficients of p(u) → those of (1 − τv)^D p((v + τ)/(1 − τv))."""
     P = np.polynomial.polynomial
@@ -214,11 +247,31 @@ class _Joint:
 
     def __post_init__(self):
         self.A = multiply(self.P, self.K)
+        # P's rotation is about z by the angle sign·θ + offset (sign −1 for a reversed chain)
+        a = self._rotation(self.parameter(np.array([0.0, 1.0])))
+        self.sign = float(np.round(_wrap(a[1] - a[0], 2 * np.pi)))
+        self.offset = a[0]
 
     def theta(self, u):
         if self.kind == "revolute":
             return _wrap(2 * np.arctan(u) + self.delta, 2 * np.pi)
         return _wrap(4 * np.arctan(u) + self.delta, 4 * np.pi)
+
+    def parameter(self, theta):
+        return np.tan((theta - self.delta) / (2 if self.kind == "revolute" else 4))
+
+    def _rotation(self, u) -> np.ndarray:
+        x = _eval(self.P, u)
+        return 2 * np.arctan2(x[:, 3], x[:, 0])
+
+    def parameters_of(self, Z: np.ndarray) -> np.ndarray:
+        """(R, 1) for an R-pair, (R, 2) for an A-pair: the parameters u whose rotation is that of
+        the points Z (R, 8) in the pair subalgebra (an A-pair's two angles θ and θ + 2π share it;
+        which of them has P(u) ∝ Z is for the caller to test)."""
+        theta = (2 * np.arctan2(Z[:, 3].real, Z[:, 0].real) - self.offset) / self.sign
+        if self.kind == "revolute":
+            return self.parameter(theta)[:, None]
+        return self.parameter(np.stack([theta, theta + 2 * np.pi], 1))
 
 
 def _pair_curve(chain, i: int, scale: float, delta: float) -> np.ndarray:
@@ -467,6 +520,20 @@ class _Elimination:
         coaxial = np.abs(outside).max(axis=(1, 2)) <= 1e-10 * np.abs(Zc).max(axis=(1, 2))
         out: list = [self._solve_coaxial(Zc[r]) if coaxial[r] else [] for r in range(len(Ws))]
         rows = np.flatnonzero(~coaxial)
+        # the usual case, one (u_1, u_2) per W, from two null vectors; the rest by eigenvalues
+        polys = np.swapaxes(outside[rows], 1, 2)  # (R, 4, D1+1)
+        u1, one = _unique_roots(_shifted(polys, polys.shape[2] - 2))
+        if not np.iscomplexobj(Ws):
+            Z = np.einsum("km,kma->ka", u1[:, None] ** np.arange(Zc.shape[1]), Zc[rows])
+            u2 = self.joints[1].parameters_of(Z)  # (R, 1 or 2), each tested
+            ok = np.stack([_relres_many(np.swapaxes(_minors(self.joints[1].P, Z), 1, 2), u2[:, j]) <= ROOT_RTOL
+                           for j in range(u2.shape[1])], 1)
+            one &= ok.any(axis=1)
+            for r, x, ys, oks in zip(rows[one], u1[one], u2[one], ok[one]):
+                out[r] = [np.array([x, y]) for y, good in zip(ys, oks) if good]
+        else:
+            one[:] = False
+        rows = rows[~one]
         u1s = _common_roots_many(np.swapaxes(outside[rows], 1, 2), self.rng)
         if any(u is None for u in u1s):
             raise _Degenerate("every polynomial vanishes identically")
