@@ -612,7 +612,7 @@ class _Elimination:
         """The real u_3 sorted by two steps of inverse iteration: the Sylvester matrix of the
         eliminated pair `pair` is singular at each u_3, and where its null vector comes out as
         (1, u_4, u_4², …) (one common root u_4), the left half's quadrics on W(u_3, u_4) accept the
-        pair (relative residual ≤ 1e-8) or reject u_3 (> 1e-4: most of the resultant's roots are
+        pair (relative residual ≤ 1e-8) or reject u_3 (> 1e-6: most of the resultant's roots are
         not common roots of the other quadrics). Returns the accepted pairs (r, 2), their images
         (r, 8), and the u_3 left undecided (no such null vector, or a residual in between) for
         _right_pairs."""
@@ -620,20 +620,15 @@ class _Elimination:
         if pair is None or len(u3s) == 0 or np.iscomplexobj(C) or np.iscomplexobj(pair[0]):
             return none
         S = _sylvester_at(*pair, u3s)
-        x = np.broadcast_to(_PROBE[:S.shape[1], None], (len(S), S.shape[1], 1))
-        try:
-            for _ in range(2):
-                x = np.linalg.solve(S, x)
-                x /= np.linalg.norm(x, axis=1, keepdims=True)
-        except np.linalg.LinAlgError:  # exactly singular somewhere
-            return none
-        x = x[:, :, 0]
+        x = _null_vectors(S)
+        solved = np.isfinite(x).all(axis=1)
         u4 = np.sum(x[:, :-1] * x[:, 1:], axis=1) / np.maximum(np.sum(x[:, :-1] ** 2, axis=1), 1e-300)
-        vandermonde = np.linalg.norm(x[:, 1:] - u4[:, None] * x[:, :-1], axis=1) <= 1e-8
+        vandermonde = solved & (np.linalg.norm(x[:, 1:] - u4[:, None] * x[:, :-1], axis=1) <= 1e-8)
+        u4 = np.where(solved, u4, 0.0)
         W = np.einsum("ri,ija->rja", u3s[:, None] ** np.arange(C.shape[0]), C)
         W = np.einsum("rj,rja->ra", u4[:, None] ** np.arange(C.shape[1]), W)
         rel = np.abs(np.einsum("ra,kab,rb->rk", W, self.Q, W)).max(axis=1) / np.maximum(np.sum(W * W, axis=1), 1e-300)
-        accept, reject = vandermonde & (rel <= 1e-8), vandermonde & ~(rel <= 1e-4)
+        accept, reject = vandermonde & (rel <= 1e-8), vandermonde & ~(rel <= 1e-6)
         return np.stack([u3s[accept], u4[accept]], 1), W[accept], u3s[~(accept | reject)]
 
     def _right_pairs(self, u3s: np.ndarray, C: np.ndarray, real: bool):
@@ -867,6 +862,21 @@ def _sylvester_at(f: np.ndarray, g: np.ndarray, u: np.ndarray) -> np.ndarray:
 
 
 _PROBE = np.random.default_rng(SEED).standard_normal(64)  # right-hand side of the inverse iterations
+
+
+def _null_vectors(S: np.ndarray) -> np.ndarray:
+    """(R, N): unit null vectors of the singular matrices S (R, N, N) by two steps of inverse
+    iteration from a fixed vector; NaN rows where LU meets an exact zero pivot."""
+    x = np.broadcast_to(_PROBE[:S.shape[1], None], (len(S), S.shape[1], 1))
+    try:
+        for _ in range(2):
+            x = np.linalg.solve(S, x)
+            x = x / np.linalg.norm(x, axis=1, keepdims=True)
+        return x[:, :, 0]
+    except np.linalg.LinAlgError:  # one by one, to find the matrix that is singular to rounding
+        if len(S) == 1:
+            return np.full((1, S.shape[1]), np.nan)
+        return np.concatenate([_null_vectors(s[None]) for s in S])
 
 
 @lru_cache(maxsize=None)
