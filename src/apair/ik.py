@@ -613,9 +613,10 @@ class _Elimination:
         eliminated pair `pair` is singular at each u_3, and where its null vector comes out as
         (1, u_4, u_4², …) (one common root u_4), the left half's quadrics on W(u_3, u_4) accept the
         pair (relative residual ≤ 1e-8) or reject u_3 (> 1e-6: most of the resultant's roots are
-        not common roots of the other quadrics). Returns the accepted pairs (r, 2), their images
-        (r, 8), and the u_3 left undecided (no such null vector, or a residual in between) for
-        _right_pairs."""
+        not common roots of the other quadrics). Where the null space is two-dimensional, each of
+        its two roots u_4 is polished by Newton and tested alike. Returns the accepted pairs (r, 2),
+        their images (r, 8), and the u_3 left undecided (a residual in between, or a null space
+        that says neither) for _right_pairs."""
         none = np.zeros((0, 2)), np.zeros((0, 8)), u3s
         if pair is None or len(u3s) == 0 or np.iscomplexobj(C) or np.iscomplexobj(pair[0]):
             return none
@@ -629,7 +630,28 @@ class _Elimination:
         W = np.einsum("rj,rja->ra", u4[:, None] ** np.arange(C.shape[1]), W)
         rel = np.abs(np.einsum("ra,kab,rb->rk", W, self.Q, W)).max(axis=1) / np.maximum(np.sum(W * W, axis=1), 1e-300)
         accept, reject = vandermonde & (rel <= 1e-8), vandermonde & ~(rel <= 1e-6)
-        return np.stack([u3s[accept], u4[accept]], 1), W[accept], u3s[~(accept | reject)]
+        pairs, images = np.stack([u3s[accept], u4[accept]], 1), W[accept]
+        # two roots u_4: each polished on the eliminated pair and tested; u_3 is decided where
+        # both are (complex ones are not solutions)
+        rows = np.flatnonzero(~vandermonde)
+        v = _two_roots(S[rows])
+        known = np.isfinite(v).all(axis=1)
+        rows, v = rows[known], v[known]
+        real = np.abs(v.imag) <= 1e-2 * (1 + np.abs(v))
+        r2, v2 = np.repeat(rows, 2)[real.ravel()], v.real.ravel()[real.ravel()]
+        a, b = _polished(*pair, u3s[r2], v2)
+        W2 = np.einsum("ri,ija->rja", a[:, None] ** np.arange(C.shape[0]), C)
+        W2 = np.einsum("rj,rja->ra", b[:, None] ** np.arange(C.shape[1]), W2)
+        rel2 = np.abs(np.einsum("ra,kab,rb->rk", W2, self.Q, W2)).max(axis=1) / np.maximum(np.sum(W2 * W2, axis=1), 1e-300)
+        good, bad = rel2 <= 1e-8, ~(rel2 <= 1e-6)
+        undecided = np.zeros(len(u3s), bool)
+        undecided[r2[~(good | bad)]] = True
+        decided = np.zeros(len(u3s), bool)
+        decided[rows] = True
+        reject |= decided & ~undecided
+        pairs = np.concatenate([pairs, np.stack([a[good], b[good]], 1)])
+        images = np.concatenate([images, W2[good]])
+        return pairs, images, u3s[~(accept | reject)]
 
     def _right_pairs(self, u3s: np.ndarray, C: np.ndarray, real: bool):
         """For each u_3, the u_4 where every quadric of the left half vanishes on W(u_3, u_4) (their
@@ -877,6 +899,45 @@ def _null_vectors(S: np.ndarray) -> np.ndarray:
         if len(S) == 1:
             return np.full((1, S.shape[1]), np.nan)
         return np.concatenate([_null_vectors(s[None]) for s in S])
+
+
+def _two_roots(S: np.ndarray) -> np.ndarray:
+    """(R, 2) for real Sylvester matrices S (R, N, N): where the null space is two-dimensional,
+    the two common roots v (the eigenvalues of the shift X with N[1:] = N[:-1]·X on a null basis
+    N), else NaN. At a real u_3 of a sinusoidal A-pair these are often v and about −1/v (the
+    joint's angles θ and θ + 2π share the rotation), and u_3 a near-double eigenvalue accurate to
+    about 1e-8: the null space is two-dimensional to about that, and the roots need polishing."""
+    out = np.full((len(S), 2), np.nan, complex)
+    if len(S) == 0:
+        return out
+    _, sv, Vt = np.linalg.svd(S)
+    two = (sv[:, -2] <= 1e-5 * sv[:, 0]) & (sv[:, -3] > 1e3 * sv[:, -2])
+    if not two.any():
+        return out
+    N = np.swapaxes(Vt[two, -2:], 1, 2)  # (r, N, 2)
+    X = np.linalg.pinv(N[:, :-1]) @ N[:, 1:]
+    shifted = np.linalg.norm(N[:, :-1] @ X - N[:, 1:], axis=(1, 2)) <= 1e-4
+    out[np.flatnonzero(two)[shifted]] = np.linalg.eigvals(X[shifted])
+    return out
+
+
+def _polished(f: np.ndarray, g: np.ndarray, u: np.ndarray, v: np.ndarray, steps: int = 3):
+    """(u, v) after Newton steps on f(u, v) = g(u, v) = 0 (coefficients [i, j] of u^i v^j), real."""
+    i, j = np.arange(f.shape[0]), np.arange(f.shape[1])
+    k, m = np.arange(g.shape[0]), np.arange(g.shape[1])
+    for _ in range(steps):
+        def at(P, a, b):  # value, ∂u, ∂v
+            pa, pb = u[:, None] ** a, v[:, None] ** b
+            da = a * np.concatenate([np.zeros((len(u), 1)), pa[:, :-1]], 1)
+            db = b * np.concatenate([np.zeros((len(v), 1)), pb[:, :-1]], 1)
+            return (np.einsum("ra,ab,rb->r", pa, P, pb), np.einsum("ra,ab,rb->r", da, P, pb),
+                    np.einsum("ra,ab,rb->r", pa, P, db))
+        F, Fu, Fv = at(f, i, j)
+        G, Gu, Gv = at(g, k, m)
+        det = Fu * Gv - Fv * Gu
+        det = np.where(det == 0, np.inf, det)
+        u, v = u - (F * Gv - Fv * G) / det, v - (Fu * G - F * Gu) / det
+    return u, v
 
 
 @lru_cache(maxsize=None)
