@@ -626,9 +626,7 @@ class _Elimination:
         u4 = np.sum(x[:, :-1] * x[:, 1:], axis=1) / np.maximum(np.sum(x[:, :-1] ** 2, axis=1), 1e-300)
         vandermonde = solved & (np.linalg.norm(x[:, 1:] - u4[:, None] * x[:, :-1], axis=1) <= 1e-8)
         u4 = np.where(solved, u4, 0.0)
-        W = np.einsum("ri,ija->rja", u3s[:, None] ** np.arange(C.shape[0]), C)
-        W = np.einsum("rj,rja->ra", u4[:, None] ** np.arange(C.shape[1]), W)
-        rel = np.abs(np.einsum("ra,kab,rb->rk", W, self.Q, W)).max(axis=1) / np.maximum(np.sum(W * W, axis=1), 1e-300)
+        W, rel = self._on_quadrics(u3s, u4, C)
         accept, reject = vandermonde & (rel <= 1e-8), vandermonde & ~(rel <= 1e-6)
         pairs, images = np.stack([u3s[accept], u4[accept]], 1), W[accept]
         # two roots u_4: each polished on the eliminated pair and tested; u_3 is decided where
@@ -640,9 +638,7 @@ class _Elimination:
         real = np.abs(v.imag) <= 1e-2 * (1 + np.abs(v))
         r2, v2 = np.repeat(rows, 2)[real.ravel()], v.real.ravel()[real.ravel()]
         a, b = _polished(*pair, u3s[r2], v2)
-        W2 = np.einsum("ri,ija->rja", a[:, None] ** np.arange(C.shape[0]), C)
-        W2 = np.einsum("rj,rja->ra", b[:, None] ** np.arange(C.shape[1]), W2)
-        rel2 = np.abs(np.einsum("ra,kab,rb->rk", W2, self.Q, W2)).max(axis=1) / np.maximum(np.sum(W2 * W2, axis=1), 1e-300)
+        W2, rel2 = self._on_quadrics(a, b, C)
         good, bad = rel2 <= 1e-8, ~(rel2 <= 1e-6)
         undecided = np.zeros(len(u3s), bool)
         undecided[r2[~(good | bad)]] = True
@@ -652,6 +648,13 @@ class _Elimination:
         pairs = np.concatenate([pairs, np.stack([a[good], b[good]], 1)])
         images = np.concatenate([images, W2[good]])
         return pairs, images, u3s[~(accept | reject)]
+
+    def _on_quadrics(self, u3: np.ndarray, u4: np.ndarray, C: np.ndarray):
+        """The images W(u_3, u_4) (r, 8) and the left half's largest quadric on each, relative to |W|²."""
+        W = np.einsum("ri,ija->rja", u3[:, None] ** np.arange(C.shape[0]), C)
+        W = np.einsum("rj,rja->ra", u4[:, None] ** np.arange(C.shape[1]), W)
+        rel = np.abs(np.einsum("ra,kab,rb->rk", W, self.Q, W)).max(axis=1) / np.maximum(np.sum(W * W, axis=1), 1e-300)
+        return W, rel
 
     def _right_pairs(self, u3s: np.ndarray, C: np.ndarray, real: bool):
         """For each u_3, the u_4 where every quadric of the left half vanishes on W(u_3, u_4) (their
