@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 7b6f674dd6753490
+Content hash: 710a31d516dd1dca
 """

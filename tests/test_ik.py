@@ -370,3 +370,96 @@ def test_parallel_axes_give_a_regular_32_root_pencil():
         roots, pair = elim._resultant_roots(elim.image @ ik._left(target).T)
         assert pair is not None and len(roots) == 32
         assert contains(forward_solutions(solver, chain, T), q, periods(chain))
+
+
+def compiled_ik():
+    from apair import ik
+
+    if ik._native() is None:
+        pytest.skip("the compiled C kernels are not installed")
+    return ik
+
+
+def test_compiled_4_joint_steps_agree_with_numpy(monkeypatch):
+    """apair_ik4_pencil, apair_ik4_screen and apair_ik4_left against the NumPy path they replace, step
+    by step, on random 4A and mixed designs, special ones and examples/4a_chain.toml (a 32-root
+    pencil of two random combinations): the same eigenvalues, screened pairs and left halves."""
+    ik = compiled_ik()
+    native = ik._native
+    rng = np.random.default_rng(21)
+    chains = [random_chain(rng, 4), random_chain(rng, 4, "sr"), random_chain(rng, 4, "r"),
+              apair.load("examples/4a_chain.toml")] + [special_chain(rng, 4) for _ in range(4)]
+    compared = 0
+    for chain in chains:
+        solver = ik.Solver(chain)
+        elim = solver._elimination(False)
+        qs = [rng.uniform(-np.pi, np.pi, 4), special_angles(rng, 4)]
+        for q in qs:
+            target = ik._study(chain.fk(q))
+            target[4:] /= solver.scale
+            if elim.pre is not None:
+                target = ik.multiply(elim.pre, ik.conjugate(target))
+            C = elim.image @ ik._left(target).T
+            steps = {}
+            for engine in ("c", "numpy"):
+                monkeypatch.setattr(ik, "_native", native if engine == "c" else (lambda: None))
+                roots, pair = elim._resultant_roots(C)
+                u3 = np.sort_complex(roots)
+                real = u3[np.abs(u3.imag) <= ik.CAND_TOL * (1 + np.abs(u3))].real
+                screened = elim._screen(real, pair, C) if pair is not None else None
+                steps[engine] = u3, pair, screened
+            (uc, pc, sc), (un, pn, sn) = steps["c"], steps["numpy"]
+            assert len(uc) == len(un)
+            # each root matched (double roots, e.g. the spurious ones at ±i, differ by about √ε)
+            finite = uc[np.abs(uc) < 1e3]  # those near infinity are ill-conditioned in either engine
+            assert np.all(np.abs(finite[:, None] - un[None]).min(axis=1) <= 1e-5 * (1 + np.abs(finite)))
+            if pc is None:
+                assert pn is None
+                continue
+            assert all(np.allclose(a, b, rtol=1e-12, atol=1e-14 * np.abs(b).max()) for a, b in zip(pc, pn))
+            if sc is not None and len(sc[0]):
+                # the same pairs (u_3, u_4), as sets: a multiple root's copies differ by about √ε
+                # or its fourth root, and either engine may accept a different number of them
+                for a, b in ((sc[0], sn[0]), (sn[0], sc[0])):
+                    assert np.all(np.abs(a[:, None] - b[None]).max(axis=2).min(axis=1) <= 1e-5 * (1 + np.abs(a).max(axis=1)))
+                lefts = {}
+                for engine in ("c", "numpy"):
+                    monkeypatch.setattr(ik, "_native", native if engine == "c" else (lambda: None))
+                    lefts[engine] = elim._solve_left_many(sc[1])
+                for a, b in zip(lefts["c"], lefts["numpy"]):
+                    assert len(a) == len(b) and all(np.allclose(x, y, rtol=1e-7) for x, y in zip(a, b))
+                compared += 1
+        # and the answers: the same verified solutions (u_3 left undecided, a residual between
+        # the screen's bounds, may differ with rounding: the common-roots path decides those)
+        answers = {}
+        for engine in ("c", "numpy"):
+            monkeypatch.setattr(ik, "_native", native if engine == "c" else (lambda: None))
+            chain._ik = None
+            answers[engine] = [chain.ik(chain.fk(q)) for q in qs]
+        for a, b in zip(answers["c"], answers["numpy"]):
+            assert a.shape == b.shape and np.allclose(a, b, atol=1e-8)
+    assert compared >= 10
+
+
+def test_compiled_left_half_refuses_only_points_off_its_surface():
+    """apair_ik4_left's "no root" (status 2) is a proof: on random Study points off the left half's
+    surface it says so, and the general path finds nothing there either; on points of the surface
+    it returns their parameters."""
+    ik = compiled_ik()
+    rng = np.random.default_rng(4)
+    chain = random_chain(rng, 4)
+    elim = ik.Solver(chain)._elimination(False)
+    j2 = elim.joints[1]
+    joint = np.array([j2.kind == "revolute", j2.delta, j2.offset, j2.sign], float)
+    x, y = rng.standard_normal((2, 20, 4))
+    y -= np.sum(x * y, axis=1, keepdims=True) / np.sum(x * x, axis=1, keepdims=True) * x
+    off = np.concatenate([x, y], 1)  # on the Study quadric, off the surface
+    status, *_ = ik._native().ik4_left(off, elim.Zmap, j2.P, joint, ik.LEFT_TOL)
+    assert np.all(status == 2)
+    assert all(len(s) == 0 for s in elim._solve_left_general(off))
+    u = np.tan(rng.uniform(-1.4, 1.4, (20, 2)))
+    on = ik.multiply(ik._eval(elim.joints[0].A, u[:, 0]), ik._eval(elim.joints[1].A, u[:, 1]))
+    status, u1, u2, ok = ik._native().ik4_left(on, elim.Zmap, j2.P, joint, ik.LEFT_TOL)
+    assert np.all(status == 0)
+    assert np.allclose(u1, u[:, 0], rtol=1e-8)
+    assert np.all(np.any(ok.astype(bool) & np.isclose(u2, u[:, 1:], rtol=1e-8), axis=1))

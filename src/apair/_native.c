@@ -792,6 +792,143 @@ done:
     return result;
 }
 
+/* ik4_pencil(C (d3+1, d4+1, 8), Qf (8, 8), af (2), Qg (8, 8), ag (2), cond_max)
+ * -> (f, g, M), or None where the leading coefficients are ill-conditioned */
+static PyObject *native_ik4_pencil(PyObject *self, PyObject *args)
+{
+    PyObject *o[6];
+    PyArrayObject *a[6] = {NULL};
+    PyObject *result = NULL;
+    double cond_max;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOd", &o[0], &o[2], &o[3], &o[4], &o[5], &cond_max)) {
+        return NULL;
+    }
+    npy_intp s_img[3] = {-1, -1, 8}, s_Q[2] = {8, 8}, s_a[1] = {2};
+    if (!(a[0] = ik_array(o[0], NPY_DOUBLE, 3, s_img, "C")) || !(a[2] = ik_array(o[2], NPY_DOUBLE, 2, s_Q, "Qf")) || !(a[3] = ik_array(o[3], NPY_INT32, 1, s_a, "af")) ||
+        !(a[4] = ik_array(o[4], NPY_DOUBLE, 2, s_Q, "Qg")) || !(a[5] = ik_array(o[5], NPY_INT32, 1, s_a, "ag"))) {
+        goto done;
+    }
+    int d3 = (int)PyArray_DIM(a[0], 0) - 1, d4 = (int)PyArray_DIM(a[0], 1) - 1;
+    const int *af = (const int *)PyArray_DATA(a[3]), *ag = (const int *)PyArray_DATA(a[5]);
+    npy_intp s_f[2] = {2 * d3 - 2 * af[0] + 1, 2 * d4 - 2 * af[1] + 1};
+    npy_intp s_g[2] = {2 * d3 - 2 * ag[0] + 1, 2 * d4 - 2 * ag[1] + 1};
+    if (s_f[0] < 2 || s_f[1] < 1 || s_g[0] < 2 || s_g[1] < 1) {
+        PyErr_SetString(PyExc_ValueError, "ik4_pencil: the factors leave an image constant in u3");
+        goto done;
+    }
+    npy_intp n = (s_g[1] - 1) * (s_f[0] - 1) + (s_f[1] - 1) * (s_g[0] - 1), s_M[2] = {n, n};
+    PyArrayObject *f = (PyArrayObject *)PyArray_SimpleNew(2, s_f, NPY_DOUBLE);
+    PyArrayObject *g = (PyArrayObject *)PyArray_SimpleNew(2, s_g, NPY_DOUBLE);
+    PyArrayObject *M = (PyArrayObject *)PyArray_SimpleNew(2, s_M, NPY_DOUBLE);
+    if (!f || !g || !M) {
+        Py_XDECREF(f); Py_XDECREF(g); Py_XDECREF(M);
+        goto done;
+    }
+    int size = 0;
+    int rc = apair_ik4_pencil(d3, d4, PyArray_DATA(a[0]), PyArray_DATA(a[2]), af,
+                              PyArray_DATA(a[4]), ag, cond_max, PyArray_DATA(f), PyArray_DATA(g), PyArray_DATA(M), &size);
+    if (rc < 0) {
+        PyErr_SetString(PyExc_ValueError, "ik4_pencil: degrees out of range");
+        Py_DECREF(f); Py_DECREF(g); Py_DECREF(M);
+        goto done;
+    }
+    if (rc > 0) {
+        Py_DECREF(f); Py_DECREF(g); Py_DECREF(M);
+        Py_INCREF(Py_None);
+        result = Py_None;
+        goto done;
+    }
+    result = Py_BuildValue("NNN", f, g, M);
+done:
+    for (int i = 0; i < 6; i++) Py_XDECREF(a[i]);
+    return result;
+}
+
+/* ik4_screen(u3 (r), C (d3+1, d4+1, 8), f, g, Q (nq, 8, 8), probe (N), tol (3))
+ * -> (status (r), u4 (r), W (r, 8), rel (r)) */
+static PyObject *native_ik4_screen(PyObject *self, PyObject *args)
+{
+    PyObject *o[7];
+    PyArrayObject *a[7] = {NULL};
+    PyObject *result = NULL;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &o[6])) {
+        return NULL;
+    }
+    npy_intp s_u[1] = {-1}, s_C[3] = {-1, -1, 8}, s_p[2] = {-1, -1}, s_Q[3] = {-1, 8, 8}, s_tol[1] = {3};
+    if (!(a[0] = ik_array(o[0], NPY_DOUBLE, 1, s_u, "u3")) || !(a[1] = ik_array(o[1], NPY_DOUBLE, 3, s_C, "C")) ||
+        !(a[2] = ik_array(o[2], NPY_DOUBLE, 2, s_p, "f")) || !(a[3] = ik_array(o[3], NPY_DOUBLE, 2, s_p, "g")) ||
+        !(a[4] = ik_array(o[4], NPY_DOUBLE, 3, s_Q, "Q")) || !(a[6] = ik_array(o[6], NPY_DOUBLE, 1, s_tol, "tol"))) {
+        goto done;
+    }
+    int F1 = (int)PyArray_DIM(a[2], 1) - 1, G1 = (int)PyArray_DIM(a[3], 1) - 1;
+    npy_intp s_probe[1] = {F1 + G1};
+    if (!(a[5] = ik_array(o[5], NPY_DOUBLE, 1, s_probe, "probe"))) goto done;
+    npy_intp count = PyArray_DIM(a[0], 0), s_W[2] = {count, 8};
+    PyArrayObject *status = (PyArrayObject *)PyArray_SimpleNew(1, s_W, NPY_INT32);
+    PyArrayObject *u4 = (PyArrayObject *)PyArray_SimpleNew(1, s_W, NPY_DOUBLE);
+    PyArrayObject *W = (PyArrayObject *)PyArray_SimpleNew(2, s_W, NPY_DOUBLE);
+    PyArrayObject *rel = (PyArrayObject *)PyArray_SimpleNew(1, s_W, NPY_DOUBLE);
+    if (!status || !u4 || !W || !rel) {
+        Py_XDECREF(status); Py_XDECREF(u4); Py_XDECREF(W); Py_XDECREF(rel);
+        goto done;
+    }
+    int rc = apair_ik4_screen((size_t)count, PyArray_DATA(a[0]), (int)PyArray_DIM(a[1], 0) - 1,
+                              (int)PyArray_DIM(a[1], 1) - 1, PyArray_DATA(a[1]), PyArray_DATA(a[2]),
+                              (int)PyArray_DIM(a[2], 0) - 1, F1, PyArray_DATA(a[3]), (int)PyArray_DIM(a[3], 0) - 1, G1,
+                              (int)PyArray_DIM(a[4], 0), PyArray_DATA(a[4]), PyArray_DATA(a[5]), PyArray_DATA(a[6]),
+                              PyArray_DATA(status), PyArray_DATA(u4), PyArray_DATA(W), PyArray_DATA(rel));
+    if (rc) {
+        PyErr_SetString(PyExc_ValueError, "ik4_screen: the Sylvester size is out of range");
+        Py_DECREF(status); Py_DECREF(u4); Py_DECREF(W); Py_DECREF(rel);
+        goto done;
+    }
+    result = Py_BuildValue("NNNN", status, u4, W, rel);
+done:
+    for (int i = 0; i < 7; i++) Py_XDECREF(a[i]);
+    return result;
+}
+
+/* ik4_left(W (r, 8), Zmap (d1+1, 8, 8), P2 (d2+1, 8), joint (4), tol (4)) -> (status (r), u1 (r), u2 (r, 2), ok (r, 2)) */
+static PyObject *native_ik4_left(PyObject *self, PyObject *args)
+{
+    PyObject *o[5];
+    PyArrayObject *a[5] = {NULL};
+    PyObject *result = NULL;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOO", &o[0], &o[1], &o[2], &o[3], &o[4])) {
+        return NULL;
+    }
+    npy_intp s_W[2] = {-1, 8}, s_Z[3] = {-1, 8, 8}, s_P[2] = {-1, 8}, s_j[1] = {4}, s_tol[1] = {4};
+    if (!(a[0] = ik_array(o[0], NPY_DOUBLE, 2, s_W, "W")) || !(a[1] = ik_array(o[1], NPY_DOUBLE, 3, s_Z, "Zmap")) ||
+        !(a[2] = ik_array(o[2], NPY_DOUBLE, 2, s_P, "P2")) || !(a[3] = ik_array(o[3], NPY_DOUBLE, 1, s_j, "joint")) ||
+        !(a[4] = ik_array(o[4], NPY_DOUBLE, 1, s_tol, "tol"))) {
+        goto done;
+    }
+    npy_intp count = PyArray_DIM(a[0], 0), s_two[2] = {count, 2};
+    PyArrayObject *status = (PyArrayObject *)PyArray_SimpleNew(1, s_two, NPY_INT32);
+    PyArrayObject *u1 = (PyArrayObject *)PyArray_SimpleNew(1, s_two, NPY_DOUBLE);
+    PyArrayObject *u2 = (PyArrayObject *)PyArray_SimpleNew(2, s_two, NPY_DOUBLE);
+    PyArrayObject *ok = (PyArrayObject *)PyArray_SimpleNew(2, s_two, NPY_INT32);
+    if (!status || !u1 || !u2 || !ok) {
+        Py_XDECREF(status); Py_XDECREF(u1); Py_XDECREF(u2); Py_XDECREF(ok);
+        goto done;
+    }
+    int rc = apair_ik4_left((size_t)count, PyArray_DATA(a[0]), (int)PyArray_DIM(a[1], 0) - 1, PyArray_DATA(a[1]),
+                            (int)PyArray_DIM(a[2], 0) - 1, PyArray_DATA(a[2]), PyArray_DATA(a[3]), PyArray_DATA(a[4]),
+                            PyArray_DATA(status), PyArray_DATA(u1), PyArray_DATA(u2), PyArray_DATA(ok));
+    if (rc) {
+        PyErr_SetString(PyExc_ValueError, "ik4_left: degrees out of range");
+        Py_DECREF(status); Py_DECREF(u1); Py_DECREF(u2); Py_DECREF(ok);
+        goto done;
+    }
+    result = Py_BuildValue("NNNN", status, u1, u2, ok);
+done:
+    for (int i = 0; i < 5; i++) Py_XDECREF(a[i]);
+    return result;
+}
+
 static PyMethodDef native_methods[] = {
     {"call", (PyCFunction)(void (*)(void))native_call, METH_FASTCALL,
      "call(index, *inputs) -> list of outputs, or None if an input needs converting first."},
@@ -804,6 +941,12 @@ static PyMethodDef native_methods[] = {
      "ik6r_angles(x3, vec, P, L, sigma, dh, T) -> theta: apair_ik6r_angles."},
     {"ik_newton", native_ik_newton, METH_VARARGS,
      "ik_newton(kind, pair, dh, p, theta, max_steps, tol, floor, stall, imag_max) -> (theta, size): apair_ik_newton."},
+    {"ik4_pencil", native_ik4_pencil, METH_VARARGS,
+     "ik4_pencil(C, Qf, af, Qg, ag, cond_max) -> (f, g, M) or None: apair_ik4_pencil."},
+    {"ik4_screen", native_ik4_screen, METH_VARARGS,
+     "ik4_screen(u3, C, f, g, Q, probe, tol) -> (status, u4, W, rel): apair_ik4_screen."},
+    {"ik4_left", native_ik4_left, METH_VARARGS,
+     "ik4_left(W, Zmap, P2, joint, tol) -> (status, u1, u2, ok): apair_ik4_left."},
     {"ik_local", native_ik_local, METH_VARARGS,
      "ik_local(kind, pair, dh, lower, upper, scale, target, seed, tol, max_iter) -> (q, residual, converged)."},
     {NULL, NULL, 0, NULL},

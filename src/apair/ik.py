@@ -61,7 +61,7 @@ import scipy.linalg
 from scipy.linalg import lapack
 
 from . import _validate as V
-from .homotopy import scale_of
+from .homotopy import _native, scale_of
 from .study import conjugate, from_matrix, multiply, normalise, to_matrix
 
 SEED = 46  # fixed: the parameter shifts and random combinations are reproducible
@@ -70,6 +70,13 @@ INSIDE = [0, 3, 4, 7]  # the subalgebra's components: 1, k, ε, εk
 ROOT_RTOL = 1e-6  # relative residual under which a root is a candidate (verification decides)
 REAL_TOL = 1e-6  # |Im u| / (1 + |u|) under which a root is taken as real
 CAND_TOL = 1e-4  # the same for an intermediate root (multiple roots lose half their digits)
+LEAD_COND = 1e10  # 1-norm condition number of the Sylvester rows' leading coefficients under which
+#                  the hidden-variable pencil is taken as regular and solved as B⁻¹A
+SCREEN_TOL = (1e-8, 1e-8, 1e-6)  # the screen: Vandermonde null vector; accept; reject (see _screen)
+# apair_ik4_left: ROOT_RTOL; a single null vector's rank gap; its Vandermonde test; no root at all
+# (the smallest singular value above 1e-4 of the largest; a root of relative residual ROOT_RTOL
+# bounds it by ROOT_RTOL·√(rows·cols) ≤ 1.2e-5 of it for the at most 16 × 8 matrices)
+LEFT_TOL = np.array([ROOT_RTOL, 1e-6, 1e-8, 1e-4])
 
 
 # ----------------------------------------------------------------------------- polynomials
@@ -479,6 +486,7 @@ class _Elimination:
             pose = np.concatenate([x, y - (x @ y) * x])  # on the Study quadric
             images = self._quadric_images(self.image @ _left(pose).T)
             self.factors = [_isotropic_factors(g) for g in images]
+            self.shapes = [_divided(g, k).shape for g, k in zip(images, self.factors)]
 
     def _half_quadrics(self):
         """Quadrics through the left half's poses (all, and in x alone) by SVD on sampled points."""
@@ -511,6 +519,22 @@ class _Elimination:
         return self._solve_left_many(W[None])[0]
 
     def _solve_left_many(self, Ws: np.ndarray) -> list[list[np.ndarray]]:
+        """Parameters (u_1, u_2) with A_1 A_2 ∝ W for each row of Ws (R, 8): the usual single
+        solution of a real W in C (apair_ik4_left, the first step of _solve_left_general) where
+        the kernels are installed, every other row by _solve_left_general."""
+        native = _native()
+        if native is None or len(Ws) == 0 or np.iscomplexobj(Ws):
+            return self._solve_left_general(Ws)
+        j2 = self.joints[1]
+        joint = np.array([j2.kind == "revolute", j2.delta, j2.offset, j2.sign], float)
+        status, u1, u2, ok = native.ik4_left(Ws, self.Zmap, j2.P, joint, LEFT_TOL)
+        out = [[np.array([x, y]) for y, good in zip(ys, oks) if good] for x, ys, oks in zip(u1, u2, ok)]
+        rest = np.flatnonzero(status == 1)  # 2: no root u_1 at all
+        for r, sols in zip(rest, self._solve_left_general(Ws[rest])):
+            out[r] = sols
+        return out
+
+    def _solve_left_general(self, Ws: np.ndarray) -> list[list[np.ndarray]]:
         """Parameters (u_1, u_2) with A_1 A_2 ∝ W for each row of Ws (R, 8), complex: the common
         roots of all rows at once."""
         if len(Ws) == 0:
@@ -522,7 +546,7 @@ class _Elimination:
         rows = np.flatnonzero(~coaxial)
         # the usual case, one (u_1, u_2) per W, from two null vectors; the rest by eigenvalues
         polys = np.swapaxes(outside[rows], 1, 2)  # (R, 4, D1+1)
-        u1, one = _unique_roots(_shifted(polys, polys.shape[2] - 2))
+        u1, one = _unique_roots(_shifted(polys, polys.shape[2] - 2))  # as apair_ik4_left does
         if not np.iscomplexobj(Ws):
             Z = np.einsum("km,kma->ka", u1[:, None] ** np.arange(Zc.shape[1]), Zc[rows])
             u2 = self.joints[1].parameters_of(Z)  # (R, 1 or 2), each tested
@@ -591,15 +615,22 @@ class _Elimination:
         the first pair's pencil. The pair with the fewest roots is tried first (special designs
         give the images more factors 1 + u²: two parallel axes halve their bidegrees). Returns
         the roots and the pair eliminated (None for a singular pencil's regular part)."""
+        native = _native()
+        # the first pair that the loop below would not skip for a row constant in u_3, in C
+        a, b = next((ab for ab in self._tries(True) if min(self.shapes[ab[0] + 1][0], self.shapes[ab[1] + 1][0]) >= 2),
+                    (0, 0))
+        if native is not None and a < b and not np.iscomplexobj(C):
+            out = native.ik4_pencil(C, self.combinations[a + 1], self._factor_array(a + 1), self.combinations[b + 1],
+                                    self._factor_array(b + 1), LEAD_COND)
+            if out is not None:
+                f, g, M = out
+                return _eigenvalues(M), (f, g)
         f, *g = self._quadric_images(C, self.factors)
 
         def poly(k: int) -> np.ndarray:  # −1: f; 0, 1, 2: random combinations; 3: without yy
             return f if k < 0 else g[k]
 
-        tries = [(0, 1), (1, 2)]
-        if np.abs(f).max() > 1e-12 * np.abs(C).max() ** 2 * np.abs(self.Qx).max():
-            tries = [(-1, k) for k in range(len(g))] + tries
-        tries.sort(key=lambda ab: _bezout(poly(ab[0]), poly(ab[1])))
+        tries = self._tries(np.abs(f).max() > 1e-12 * np.abs(C).max() ** 2 * np.abs(self.Qx).max())
         for a, b in tries:
             try:
                 return _hidden_variable(poly(a), poly(b), self.rng, singular_ok=False), (poly(a), poly(b))
@@ -607,6 +638,16 @@ class _Elimination:
                 continue
         # every pair shares a curve
         return _hidden_variable(poly(tries[0][0]), poly(tries[0][1]), self.rng), None
+
+    def _tries(self, with_f: bool) -> list[tuple[int, int]]:
+        """The pairs of images to eliminate (−1: f; k ≥ 0: the k-th other), fewest roots first."""
+        tries = [(0, 1), (1, 2)]
+        if with_f:
+            tries = [(-1, k) for k in range(len(self.combinations) - 1)] + tries
+        return sorted(tries, key=lambda ab: _bezout_of(self.shapes[ab[0] + 1], self.shapes[ab[1] + 1]))
+
+    def _factor_array(self, k: int) -> np.ndarray:
+        return np.array(self.factors[k], np.int32)
 
     def _screen(self, u3s: np.ndarray, pair, C: np.ndarray):
         """The real u_3 sorted by two steps of inverse iteration: the Sylvester matrix of the
@@ -620,26 +661,34 @@ class _Elimination:
         none = np.zeros((0, 2)), np.zeros((0, 8)), u3s
         if pair is None or len(u3s) == 0 or np.iscomplexobj(C) or np.iscomplexobj(pair[0]):
             return none
-        S = _sylvester_at(*pair, u3s)
-        x = _null_vectors(S)
-        solved = np.isfinite(x).all(axis=1)
-        u4 = np.sum(x[:, :-1] * x[:, 1:], axis=1) / np.maximum(np.sum(x[:, :-1] ** 2, axis=1), 1e-300)
-        vandermonde = solved & (np.linalg.norm(x[:, 1:] - u4[:, None] * x[:, :-1], axis=1) <= 1e-8)
-        u4 = np.where(solved, u4, 0.0)
-        W, rel = self._on_quadrics(u3s, u4, C)
-        accept, reject = vandermonde & (rel <= 1e-8), vandermonde & ~(rel <= 1e-6)
+        vand_tol, accept_tol, reject_tol = SCREEN_TOL
+        native = _native()
+        if native is not None:  # in C (apair_ik4_screen)
+            N = pair[0].shape[1] + pair[1].shape[1] - 2
+            status, u4, W, rel = native.ik4_screen(u3s, C, pair[0], pair[1], self.Q, _PROBE[:N], np.array(SCREEN_TOL))
+            vandermonde = status != 3
+        else:
+            x = _null_vectors(_sylvester_at(*pair, u3s))
+            solved = np.isfinite(x).all(axis=1)
+            u4 = np.sum(x[:, :-1] * x[:, 1:], axis=1) / np.maximum(np.sum(x[:, :-1] ** 2, axis=1), 1e-300)
+            vandermonde = solved & (np.linalg.norm(x[:, 1:] - u4[:, None] * x[:, :-1], axis=1) <= vand_tol)
+            u4 = np.where(solved, u4, 0.0)
+            W, rel = self._on_quadrics(u3s, u4, C)
+        accept, reject = vandermonde & (rel <= accept_tol), vandermonde & ~(rel <= reject_tol)
         pairs, images = np.stack([u3s[accept], u4[accept]], 1), W[accept]
+        rows = np.flatnonzero(~vandermonde)
+        if len(rows) == 0:
+            return pairs, images, u3s[~(accept | reject)]
         # two roots u_4: each polished on the eliminated pair and tested; u_3 is decided where
         # both are (complex ones are not solutions)
-        rows = np.flatnonzero(~vandermonde)
-        v = _two_roots(S[rows])
+        v = _two_roots(_sylvester_at(*pair, u3s[rows]))
         known = np.isfinite(v).all(axis=1)
         rows, v = rows[known], v[known]
         real = np.abs(v.imag) <= 1e-2 * (1 + np.abs(v))
         r2, v2 = np.repeat(rows, 2)[real.ravel()], v.real.ravel()[real.ravel()]
         a, b = _polished(*pair, u3s[r2], v2)
         W2, rel2 = self._on_quadrics(a, b, C)
-        good, bad = rel2 <= 1e-8, ~(rel2 <= 1e-6)
+        good, bad = rel2 <= accept_tol, ~(rel2 <= reject_tol)
         undecided = np.zeros(len(u3s), bool)
         undecided[r2[~(good | bad)]] = True
         decided = np.zeros(len(u3s), bool)
@@ -857,9 +906,10 @@ def _isotropic_product(d: int) -> np.ndarray:
     return np.eye(d + 3, d + 1) + np.eye(d + 3, d + 1, -2)
 
 
-def _bezout(f: np.ndarray, g: np.ndarray) -> int:
-    """The number of common zeros in P¹ × P¹ of two bivariate polynomials (their bidegrees)."""
-    return (f.shape[0] - 1) * (g.shape[1] - 1) + (f.shape[1] - 1) * (g.shape[0] - 1)
+def _bezout_of(f: tuple, g: tuple) -> int:
+    """The number of common zeros in P¹ × P¹ of two bivariate polynomials of coefficient shapes
+    f and g (their bidegrees plus one)."""
+    return (f[0] - 1) * (g[1] - 1) + (f[1] - 1) * (g[0] - 1)
 
 
 @lru_cache(maxsize=None)
@@ -982,6 +1032,13 @@ def _hidden_variable(f: np.ndarray, g: np.ndarray, rng, singular_ok: bool = True
     for (lo, d), row in zip(blocks, rows):  # the last N rows: Σ_i row_i(u)ᵀ w_i = 0
         A[size - N:, lo: lo + d] = -row[:d].T
         B[size - N:, lo + d - 1] = row[d]
+    lead_cols = [lo + d - 1 for lo, d in blocks]
+    lead = B[size - N:, lead_cols]  # B is I plus this block, permuted
+    if np.linalg.cond(lead, 1) < LEAD_COND:  # then the pencil is regular (det has its full degree)
+        M = np.zeros((size, size), dtype)  # B⁻¹A: the shift rows as they are, lead⁻¹ times the last N rows
+        M[shift_cols, shift_cols + 1] = 1.0
+        M[lead_cols] = np.linalg.solve(lead, A[size - N:])
+        return _eigenvalues(M)
     z = np.exp(2j * np.pi * rng.random())  # a random point on the unit circle
     sv = np.linalg.svd(np.stack([z ** np.arange(len(r)) @ r for r in rows]), compute_uv=False)
     deficit = int(np.count_nonzero(sv <= 1e-11 * sv[0]))
@@ -989,20 +1046,16 @@ def _hidden_variable(f: np.ndarray, g: np.ndarray, rng, singular_ok: bool = True
         if not singular_ok:
             raise _Degenerate("f and g have a common factor")
         return _regular_eigenvalues(A, B, deficit, rng)
-    lead_cols = [lo + d - 1 for lo, d in blocks]
-    lead = B[size - N:, lead_cols]  # B is I plus this block, permuted
-    if np.linalg.cond(lead) < 1e10:  # B⁻¹A: the shift rows as they are, lead⁻¹ times the last N rows
-        M = np.zeros((size, size), dtype)
-        M[shift_cols, shift_cols + 1] = 1.0
-        M[lead_cols] = np.linalg.solve(lead, A[size - N:])
-        if dtype == complex:
-            return np.linalg.eigvals(M)
-        wr, wi, _, _, info = lapack.dgeev(M, compute_vl=0, compute_vr=0)  # NumPy's wrapper costs more
-        if info == 0:
-            return wr + 1j * wi
-        return np.linalg.eigvals(M)
     w = scipy.linalg.eigvals(A, B)
     return w[np.isfinite(w)]
+
+
+def _eigenvalues(M: np.ndarray) -> np.ndarray:
+    """The eigenvalues of a square matrix (real: LAPACK's dgeev directly, NumPy's wrapper costs more)."""
+    if np.iscomplexobj(M):
+        return np.linalg.eigvals(M)
+    wr, wi, _, _, info = lapack.dgeev(M, compute_vl=0, compute_vr=0)
+    return wr + 1j * wi if info == 0 else np.linalg.eigvals(M)
 
 
 def _regular_eigenvalues(A: np.ndarray, B: np.ndarray, k: int, rng, tol: float = 1e-5) -> np.ndarray:
