@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 710a31d516dd1dca
+Content hash: 89e0954d8ba60280
 """

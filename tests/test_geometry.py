@@ -99,6 +99,23 @@ def test_study_point_is_the_same_pose(n, backend):
         back = from_matrix(T)
         sign = np.sign(np.sum(back[:, :4] * S[:, :4], axis=1))[:, None]
         np.testing.assert_allclose(sign * back, S, atol=1e-12)
+        # one pose at a time (its own code path): the same point, the same sign
+        np.testing.assert_allclose(np.array([from_matrix(t) for t in T]), back, rtol=0, atol=1e-15)
+
+
+def test_single_pose_study_point_at_half_turns():
+    """from_matrix of one pose and of a stack agree where Shepperd's branch changes: rotations by
+    0 and π about each axis and about diagonals, where two diagonal candidates tie."""
+    from scipy.spatial.transform import Rotation
+
+    axes = np.vstack([np.eye(3), np.ones((1, 3)) / np.sqrt(3), [[1, -1, 0]] / np.sqrt(2)])
+    T = np.tile(np.eye(4), (len(axes) * 4, 1, 1))
+    for k, (axis, angle) in enumerate((a, t) for a in axes for t in (0.0, np.pi / 2, np.pi, -np.pi)):
+        T[k, :3, :3] = Rotation.from_rotvec(angle * axis).as_matrix()
+        T[k, :3, 3] = [0.3, -0.2, 1.5]
+    stack = from_matrix(T)
+    np.testing.assert_allclose(np.array([from_matrix(t) for t in T]), stack, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(to_matrix(stack), T, atol=1e-14)
 
 
 @pytest.mark.parametrize("kind", ["sinusoidal", "general"])

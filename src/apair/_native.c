@@ -792,16 +792,17 @@ done:
     return result;
 }
 
-/* ik4_pencil(C (d3+1, d4+1, 8), Qf (8, 8), af (2), Qg (8, 8), ag (2), cond_max)
+/* ik4_pencil(C (d3+1, d4+1, 8), Qf (8, 8), af (2), Qg (8, 8), ag (2), cond_max, deflate, deflate_tol)
  * -> (f, g, M), or None where the leading coefficients are ill-conditioned */
 static PyObject *native_ik4_pencil(PyObject *self, PyObject *args)
 {
     PyObject *o[6];
     PyArrayObject *a[6] = {NULL};
     PyObject *result = NULL;
-    double cond_max;
+    double cond_max, deflate_tol;
+    int deflate;
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOd", &o[0], &o[2], &o[3], &o[4], &o[5], &cond_max)) {
+    if (!PyArg_ParseTuple(args, "OOOOOdid", &o[0], &o[2], &o[3], &o[4], &o[5], &cond_max, &deflate, &deflate_tol)) {
         return NULL;
     }
     npy_intp s_img[3] = {-1, -1, 8}, s_Q[2] = {8, 8}, s_a[1] = {2};
@@ -813,6 +814,9 @@ static PyObject *native_ik4_pencil(PyObject *self, PyObject *args)
     const int *af = (const int *)PyArray_DATA(a[3]), *ag = (const int *)PyArray_DATA(a[5]);
     npy_intp s_f[2] = {2 * d3 - 2 * af[0] + 1, 2 * d4 - 2 * af[1] + 1};
     npy_intp s_g[2] = {2 * d3 - 2 * ag[0] + 1, 2 * d4 - 2 * ag[1] + 1};
+    if (deflate) { /* (g - a f) / (1 + u3^2): degree max(G0, F0 + 1) - 2 in u3 */
+        s_g[0] = (s_g[0] > s_f[0] + 1 ? s_g[0] : s_f[0] + 1) - 2;
+    }
     if (s_f[0] < 2 || s_f[1] < 1 || s_g[0] < 2 || s_g[1] < 1) {
         PyErr_SetString(PyExc_ValueError, "ik4_pencil: the factors leave an image constant in u3");
         goto done;
@@ -826,8 +830,8 @@ static PyObject *native_ik4_pencil(PyObject *self, PyObject *args)
         goto done;
     }
     int size = 0;
-    int rc = apair_ik4_pencil(d3, d4, PyArray_DATA(a[0]), PyArray_DATA(a[2]), af,
-                              PyArray_DATA(a[4]), ag, cond_max, PyArray_DATA(f), PyArray_DATA(g), PyArray_DATA(M), &size);
+    int rc = apair_ik4_pencil(d3, d4, PyArray_DATA(a[0]), PyArray_DATA(a[2]), af, PyArray_DATA(a[4]), ag, cond_max,
+                              deflate, deflate_tol, PyArray_DATA(f), PyArray_DATA(g), PyArray_DATA(M), &size);
     if (rc < 0) {
         PyErr_SetString(PyExc_ValueError, "ik4_pencil: degrees out of range");
         Py_DECREF(f); Py_DECREF(g); Py_DECREF(M);
@@ -942,7 +946,7 @@ static PyMethodDef native_methods[] = {
     {"ik_newton", native_ik_newton, METH_VARARGS,
      "ik_newton(kind, pair, dh, p, theta, max_steps, tol, floor, stall, imag_max) -> (theta, size): apair_ik_newton."},
     {"ik4_pencil", native_ik4_pencil, METH_VARARGS,
-     "ik4_pencil(C, Qf, af, Qg, ag, cond_max) -> (f, g, M) or None: apair_ik4_pencil."},
+     "ik4_pencil(C, Qf, af, Qg, ag, cond_max, deflate, deflate_tol) -> (f, g, M) or None: apair_ik4_pencil."},
     {"ik4_screen", native_ik4_screen, METH_VARARGS,
      "ik4_screen(u3, C, f, g, Q, probe, tol) -> (status, u4, W, rel): apair_ik4_screen."},
     {"ik4_left", native_ik4_left, METH_VARARGS,

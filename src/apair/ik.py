@@ -72,7 +72,9 @@ REAL_TOL = 1e-6  # |Im u| / (1 + |u|) under which a root is taken as real
 CAND_TOL = 1e-4  # the same for an intermediate root (multiple roots lose half their digits)
 LEAD_COND = 1e10  # 1-norm condition number of the Sylvester rows' leading coefficients under which
 #                  the hidden-variable pencil is taken as regular and solved as B⁻¹A
+DEFLATE_TOL = 1e-10  # relative residual of g(±i, ·) = f(±i, ·)·h under which g is deflated (_deflated)
 SCREEN_TOL = (1e-8, 1e-8, 1e-6)  # the screen: Vandermonde null vector; accept; reject (see _screen)
+_SCREEN_TOL = np.array(SCREEN_TOL)
 # apair_ik4_left: ROOT_RTOL; a single null vector's rank gap; its Vandermonde test; no root at all
 # (the smallest singular value above 1e-4 of the largest; a root of relative residual ROOT_RTOL
 # bounds it by ROOT_RTOL·√(rows·cols) ≤ 1.2e-5 of it for the at most 16 × 8 matrices)
@@ -211,6 +213,9 @@ def _with_twins(chain, q: np.ndarray, near: float = 1e-4) -> np.ndarray:
     then reads its angles back sees that pose once; the twin is its second preimage."""
     if len(q) == 0:
         return q
+    periods = _periods(chain)
+    if not np.any(np.abs(np.abs(q[:, periods > 2 * np.pi]) - np.pi) <= near):
+        return q
     out = [q]
     for i, p in enumerate(chain.pairs):
         if p.kind == "revolute":
@@ -243,7 +248,7 @@ def _trans(axis: int, dist: float) -> np.ndarray:
 
 @dataclass
 class _Joint:
-    """Joint i in a shifted parameter u: P(u) (D+1, 8); the constant K and K⁻¹; and the map u → θ."""
+    """Joint i in a shifted parameter u: P(u) (D+1, 8); the constant K and K⁻¹; and the map θ → u."""
 
     kind: str
     delta: float
@@ -258,11 +263,6 @@ class _Joint:
         a = self._rotation(self.parameter(np.array([0.0, 1.0])))
         self.sign = float(np.round(_wrap(a[1] - a[0], 2 * np.pi)))
         self.offset = a[0]
-
-    def theta(self, u):
-        if self.kind == "revolute":
-            return _wrap(2 * np.arctan(u) + self.delta, 2 * np.pi)
-        return _wrap(4 * np.arctan(u) + self.delta, 4 * np.pi)
 
     def parameter(self, theta):
         return np.tan((theta - self.delta) / (2 if self.kind == "revolute" else 4))
@@ -460,6 +460,8 @@ class _Elimination:
         self.rng = np.random.default_rng(seed)
         deltas = self.rng.uniform(-np.pi, np.pi, n)
         self.joints, self.pre = _chain_joints(chain, scale, deltas, reverse)
+        self.theta_map = (np.array([2.0 if j.kind == "revolute" else 4.0 for j in self.joints]),
+                          np.array([j.delta for j in self.joints]))
         j1 = self.joints[0]
         if n >= 2:  # Z(u_1) = K_1⁻¹·P̃_1(u_1)·W·K_2⁻¹ = Σ u_1^m Zmap[m] W
             right = _right(self.joints[1].Kinv)
@@ -486,7 +488,12 @@ class _Elimination:
             pose = np.concatenate([x, y - (x @ y) * x])  # on the Study quadric
             images = self._quadric_images(self.image @ _left(pose).T)
             self.factors = [_isotropic_factors(g) for g in images]
-            self.shapes = [_divided(g, k).shape for g, k in zip(images, self.factors)]
+            divided = [_divided(g, k) for g, k in zip(images, self.factors)]
+            self.shapes = [d.shape for d in divided]
+            # the pairs whose resultant has the factor (1 + u_3²)^m at every pose (g(±i, ·) a
+            # multiple of f(±i, ·)): deflated (_deflated) where that holds at the pose too
+            self.deflatable = {(a, b): _deflated(divided[a + 1], divided[b + 1]) is not None
+                               for a, b in self._tries(True)}
 
     def _half_quadrics(self):
         """Quadrics through the left half's poses (all, and in x alone) by SVD on sampled points."""
@@ -507,8 +514,8 @@ class _Elimination:
         """Joint angles (k, n) in the chain's order from real parameter vectors (k, n)."""
         if len(real) == 0:
             return np.zeros((0, self.chain.n))
-        U = np.real(real)
-        q = np.stack([j.theta(U[:, i]) for i, j in enumerate(self.joints)], 1)
+        k, delta = self.theta_map  # θ = k·arctan(u) + δ (k = 2 for an R-pair, 4 for an A-pair): _Joint.parameter inverted
+        q = _wrap(k * np.arctan(np.real(real)) + delta, np.pi * k)
         return q[:, ::-1] if self.reverse else q
 
     def _solve_left(self, W: np.ndarray, n: int) -> list[np.ndarray]:
@@ -621,7 +628,7 @@ class _Elimination:
                     (0, 0))
         if native is not None and a < b and not np.iscomplexobj(C):
             out = native.ik4_pencil(C, self.combinations[a + 1], self._factor_array(a + 1), self.combinations[b + 1],
-                                    self._factor_array(b + 1), LEAD_COND)
+                                    self._factor_array(b + 1), LEAD_COND, int(self.deflatable[a, b]), DEFLATE_TOL)
             if out is not None:
                 f, g, M = out
                 return _eigenvalues(M), (f, g)
@@ -632,8 +639,12 @@ class _Elimination:
 
         tries = self._tries(np.abs(f).max() > 1e-12 * np.abs(C).max() ** 2 * np.abs(self.Qx).max())
         for a, b in tries:
+            pa, pb = poly(a), poly(b)
+            if self.deflatable[a, b]:
+                deflated = _deflated(pa, pb)
+                pb = pb if deflated is None else deflated
             try:
-                return _hidden_variable(poly(a), poly(b), self.rng, singular_ok=False), (poly(a), poly(b))
+                return _hidden_variable(pa, pb, self.rng, singular_ok=False), (pa, pb)
             except _Degenerate:
                 continue
         # every pair shares a curve
@@ -665,7 +676,7 @@ class _Elimination:
         native = _native()
         if native is not None:  # in C (apair_ik4_screen)
             N = pair[0].shape[1] + pair[1].shape[1] - 2
-            status, u4, W, rel = native.ik4_screen(u3s, C, pair[0], pair[1], self.Q, _PROBE[:N], np.array(SCREEN_TOL))
+            status, u4, W, rel = native.ik4_screen(u3s, C, pair[0], pair[1], self.Q, _PROBE[:N], _SCREEN_TOL)
             vandermonde = status != 3
         else:
             x = _null_vectors(_sylvester_at(*pair, u3s))
@@ -742,10 +753,11 @@ class _Elimination:
             images = [(r[0] ** np.arange(len(C))) @ C for r in rights]
         else:
             u3s, pair = self._resultant_roots(C)
-            u3s = _with_means(u3s)
             if count_complex:
-                rights, images = self._right_pairs(u3s, C, real=False)
+                rights, images = self._right_pairs(_with_means(u3s), C, real=False)
             else:
+                # a mean within CAND_TOL of the real axis has both roots within 2·CAND_TOL of it
+                u3s = _with_means(u3s[np.abs(u3s.imag) <= 2 * CAND_TOL * (1 + np.abs(u3s))])
                 u3s = u3s[np.abs(u3s.imag) <= CAND_TOL * (1 + np.abs(u3s))].real
                 rights, images, rest = self._screen(u3s, pair, C)
                 if len(rest):
@@ -784,6 +796,8 @@ def _with_cluster_means(pairs: np.ndarray, images: np.ndarray, C: np.ndarray):
     about √ε apart, too inaccurate for the left half, while their mean is accurate to about ε.
     Candidates are kept as they are, so two close genuine solutions are not merged (verification
     and deduplication decide)."""
+    if len(pairs) < 2:
+        return pairs, images
     i, j = _close_pairs(pairs)
     if len(i) == 0:
         return pairs, images
@@ -798,9 +812,13 @@ _LEFT = np.stack([multiply(e, _EYE8).T for e in _EYE8])  # _LEFT[a] @ v = e_a·v
 _RIGHT = np.stack([multiply(_EYE8, e).T for e in _EYE8])  # _RIGHT[a] @ v = v·e_a
 
 
+_LEFT_ROWS = _LEFT.reshape(8, 64)
+
+
 def _left(p: np.ndarray) -> np.ndarray:
     """The 8×8 matrix of v ↦ p·v (Study product)."""
-    return np.tensordot(p, _LEFT, 1)
+    p = np.asarray(p)
+    return (p @ _LEFT_ROWS).reshape(p.shape[:-1] + (8, 8))
 
 
 def _right(p: np.ndarray) -> np.ndarray:
@@ -904,6 +922,39 @@ def _isotropic_division(d: int, m: int) -> np.ndarray:
 def _isotropic_product(d: int) -> np.ndarray:
     """The matrix ((d + 3) × (d + 1)) of q ↦ (1 + u²)·q for q of degree d."""
     return np.eye(d + 3, d + 1) + np.eye(d + 3, d + 1, -2)
+
+
+def _deflated(f: np.ndarray, g: np.ndarray, tol: float = None) -> np.ndarray | None:
+    """g'' = (g − a·f) / (1 + u²) for bivariate f, g (coefficients [i, j] of u^i v^j, g's degree in v
+    at least f's), where g(±i, v) = f(±i, v)·h(v) (to relative residual tol): a(u, v) = Re h(v) +
+    u Im h(v), so g − a·f vanishes at u = ±i. f and g'' have the common roots of f and g except
+    at u = ±i (never a displacement), and their resultant the degree of theirs less 2·deg_v f:
+    the images' pair (f, the quadric without yy) has 8 spurious roots at ±i, 48 → 40. None where
+    g(±i, ·) is no such multiple (or f(±i, ·) vanishes). In C, apair_ik4_pencil does the same."""
+    tol = DEFLATE_TOL if tol is None else tol
+    df, dg = f.shape[1] - 1, g.shape[1] - 1
+    if dg < df or f.shape[0] < 1:
+        return None
+    fi = (1j ** np.arange(f.shape[0])) @ f
+    gi = (1j ** np.arange(g.shape[0])) @ g
+    k = dg - df
+    A = np.zeros((dg + 1, k + 1), complex)  # g(i, ·) = f(i, ·)·h: convolution by f(i, ·)
+    for j in range(k + 1):
+        A[j: j + df + 1, j] = fi
+    if not (np.abs(fi).max() > 0 and np.abs(gi).max() > 0):
+        return None
+    h = np.linalg.lstsq(A, gi, rcond=None)[0]
+    if not np.abs(A @ h - gi).max() <= tol * np.abs(gi).max():
+        return None
+    rows = max(g.shape[0], f.shape[0] + 1)
+    if rows < 4:  # the quotient would be constant in u
+        return None
+    out = np.zeros((rows, dg + 1))
+    out[:g.shape[0]] = g
+    for i, part in enumerate((h.real, h.imag)):  # − a·f, a = Re h + u Im h
+        for j, c in enumerate(part):
+            out[i: i + f.shape[0], j: j + df + 1] -= c * f
+    return _isotropic_division(rows - 1, 1) @ out
 
 
 def _bezout_of(f: tuple, g: tuple) -> int:
@@ -1115,18 +1166,20 @@ def _pose_matrix(T) -> np.ndarray:
 
 
 _LAST_ROW, _EYE3 = np.array([0.0, 0, 0, 1]), np.eye(3)
+_LAST_TOL = 1e-12 + 1e-5 * _LAST_ROW
 
 
 def _check_matrix(T: np.ndarray) -> np.ndarray:
     """T (4, 4) or a stack (..., 4, 4) of rigid transforms, checked at once: last row [0, 0, 0, 1],
     rotation part orthonormal with det +1."""
     rows = T[..., 3, :].reshape(-1, 4)
-    bad = np.flatnonzero(~np.all(np.abs(rows - _LAST_ROW) <= 1e-12 + 1e-5 * _LAST_ROW, axis=1))
-    if len(bad):
+    good = np.abs(rows - _LAST_ROW) <= _LAST_TOL
+    if not good.all():
+        bad = np.flatnonzero(~good.all(axis=1))
         raise ValueError(f"T: last row must be [0, 0, 0, 1], got {rows[bad[0]].tolist()}")
     R = T[..., :3, :3]
-    ortho = np.abs(np.swapaxes(R, -1, -2) @ R - _EYE3).max(axis=(-2, -1))
-    if np.any(~(ortho <= 1e-9)) or np.any(np.linalg.det(R) < 0):
+    ortho = np.abs(np.swapaxes(R, -1, -2) @ R - _EYE3)
+    if ortho.size and (not (ortho.max() <= 1e-9) or not (np.linalg.det(R) > 0).all()):
         raise ValueError("T: the rotation part is not a proper rotation (orthonormal, det +1)")
     return T
 
@@ -1155,8 +1208,8 @@ def _refine(chain, q: np.ndarray, T: np.ndarray, tol: float):
     q = _wrap(q, periods)
     keep = err <= tol
     q, err = q[keep], err[keep]
-    if len(q) == 0:
-        return np.zeros((0, chain.n)), np.zeros(0)
+    if len(q) <= 1:
+        return (q, err) if len(q) else (np.zeros((0, chain.n)), np.zeros(0))
     order = np.argsort(err, kind="stable")
     q, err = q[order], err[order]
     d = np.abs(q[:, None] - q[None])

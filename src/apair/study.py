@@ -1,6 +1,8 @@
 """Study parameters: the normalisation used by the runtime (docs/conventions.md §1)."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -62,9 +64,18 @@ _HALF_T = np.array([[[0, -1, 0, 0], [0, 0, -1, 0], [0, 0, 0, -1]],
                     [[0, 0, 1, 0], [0, -1, 0, 0], [1, 0, 0, 0]]], float)
 
 
+_HALF_T_ROWS = np.ascontiguousarray(_HALF_T.transpose(1, 0, 2).reshape(3, 16))  # t ↦ Σ_a t_a L[i, a, b]
+
+
 def from_matrix(T) -> np.ndarray:
     """(..., 4, 4) rigid transforms -> unit Study points (Shepperd's branch choice for x)."""
     T = np.asarray(T, dtype=np.float64)
+    if T.shape == (4, 4):  # one pose: the same steps, with fewer array operations
+        C, D = _SHEPPERD
+        K = (T[:3, :3].reshape(9) @ C).reshape(4, 4) + D
+        x = K[int(np.argmax(K.diagonal()))]
+        x = x / math.sqrt(x @ x)
+        return np.concatenate([x, 0.5 * ((T[:3, 3] @ _HALF_T_ROWS).reshape(4, 4) @ x)])
     C, D = _SHEPPERD
     K = (T[..., :3, :3].reshape(T.shape[:-2] + (9,)) @ C).reshape(T.shape[:-2] + (4, 4)) + D
     k = np.argmax(np.diagonal(K, axis1=-2, axis2=-1), axis=-1)
