@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 89e0954d8ba60280
+Content hash: 0c8beb2c00656460
 """

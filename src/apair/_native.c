@@ -814,8 +814,11 @@ static PyObject *native_ik4_pencil(PyObject *self, PyObject *args)
     const int *af = (const int *)PyArray_DATA(a[3]), *ag = (const int *)PyArray_DATA(a[5]);
     npy_intp s_f[2] = {2 * d3 - 2 * af[0] + 1, 2 * d4 - 2 * af[1] + 1};
     npy_intp s_g[2] = {2 * d3 - 2 * ag[0] + 1, 2 * d4 - 2 * ag[1] + 1};
-    if (deflate) { /* (g - a f) / (1 + u3^2): degree max(G0, F0 + 1) - 2 in u3 */
+    if (deflate & 1) { /* (g - a f) / (1 + u3^2): degree max(G0, F0 + 1) - 2 in u3 */
         s_g[0] = (s_g[0] > s_f[0] + 1 ? s_g[0] : s_f[0] + 1) - 2;
+    }
+    if (deflate & 2) { /* and the same in u4 */
+        s_g[1] = (s_g[1] > s_f[1] + 1 ? s_g[1] : s_f[1] + 1) - 2;
     }
     if (s_f[0] < 2 || s_f[1] < 1 || s_g[0] < 2 || s_g[1] < 1) {
         PyErr_SetString(PyExc_ValueError, "ik4_pencil: the factors leave an image constant in u3");

@@ -16,12 +16,15 @@ parameter is shifted by a random angle (a Möbius substitution) so that no solut
   (8, 8), less the factors 1 + u² they carry at every pose (found once per design and divided
   out): the quadric in x alone (the spherical two-joint condition) gives f of bidegree (4, 4), a
   quadric without a yy block g of bidegree (6, 6) (for A-pairs), random combinations (8, 8).
-  The resultant in u_4 of f and g (degree 48 in u_3) is never expanded: the Sylvester matrix in
-  u_4, whose rows have degree 4 or 6 in u_3, is linearised by rows into a 48 × 48 eigenvalue
-  problem. At each real eigenvalue u_3 the Sylvester matrix's null vector (1, u_4, u_4², …)
-  gives u_4, and the pair is kept if every quadric of the left half vanishes on its image
-  (`_screen`; undecided ones get the common roots u_4 of all quadrics, `_right_pairs`); the left
-  half is then solved for W(u_3, u_4) as above.
+  Their resultant in u_4 has degree 48 in u_3, 16 of its roots spurious: at u_3 = ±i and where
+  u_4 = ±i, g is a multiple of f, and g − a·f, divided by 1 + u², removes them (`_deflated`:
+  bidegree (4, 4), 32 roots). The resultant is never expanded: the Sylvester matrix in u_4, whose
+  rows have degree 4 in u_3, is linearised by rows into a 32 × 32 eigenvalue problem. At each
+  real eigenvalue u_3 the Sylvester matrix's null vector (1, u_4, u_4², …) gives u_4, and the
+  pair is kept if every quadric of the left half vanishes on its image (`_screen`; undecided
+  ones get the common roots u_4 of all quadrics, `_right_pairs`); the left half is then solved
+  for W(u_3, u_4) as above. The usual path of every step is in generated C (apair_ik4_pencil,
+  apair_ik4_screen, apair_ik4_left) where the kernels are installed, NumPy otherwise.
 
 Special designs (twists of 0 and 90°, zero lengths: what robots are built from) make parts of this
 degenerate, and each has its own remedy:
@@ -490,10 +493,15 @@ class _Elimination:
             self.factors = [_isotropic_factors(g) for g in images]
             divided = [_divided(g, k) for g, k in zip(images, self.factors)]
             self.shapes = [d.shape for d in divided]
-            # the pairs whose resultant has the factor (1 + u_3²)^m at every pose (g(±i, ·) a
-            # multiple of f(±i, ·)): deflated (_deflated) where that holds at the pose too
-            self.deflatable = {(a, b): _deflated(divided[a + 1], divided[b + 1]) is not None
-                               for a, b in self._tries(True)}
+            # per pair, whether g(±i, ·) is a multiple of f(±i, ·), and then g(·, ±i) one of
+            # f(·, ±i): the spurious roots at u_3 = ±i and at u_4 = ±i (_deflated), removed where
+            # that holds at the pose too
+            self.deflatable = {}
+            for a, b in self._tries(True):
+                f, g = divided[a + 1], divided[b + 1]
+                du = _deflated(f, g)
+                dv = _deflated(f.T, (g if du is None else du).T)
+                self.deflatable[a, b] = (du is not None, dv is not None)
 
     def _half_quadrics(self):
         """Quadrics through the left half's poses (all, and in x alone) by SVD on sampled points."""
@@ -514,7 +522,7 @@ class _Elimination:
         """Joint angles (k, n) in the chain's order from real parameter vectors (k, n)."""
         if len(real) == 0:
             return np.zeros((0, self.chain.n))
-        k, delta = self.theta_map  # θ = k·arctan(u) + δ (k = 2 for an R-pair, 4 for an A-pair): _Joint.parameter inverted
+        k, delta = self.theta_map  # θ = k·arctan(u) + δ, k = 2 (R-pair) or 4: _Joint.parameter inverted
         q = _wrap(k * np.arctan(np.real(real)) + delta, np.pi * k)
         return q[:, ::-1] if self.reverse else q
 
@@ -616,8 +624,9 @@ class _Elimination:
     def _resultant_roots(self, C: np.ndarray):
         """Every u_3 at which two conditions on W(u_3, u_4) have a common root u_4: the rotation
         condition f (bidegree (4, 4)) with a combination g of the quadrics (the one without a yy
-        block first: bidegree (6, 6), 48 roots), else (where f vanishes on the whole image, or f
-        and g share a curve, as special designs make them) other combinations, until the
+        block first: bidegree (6, 6), 48 roots, 32 once deflated, `_deflated`), else (where f
+        vanishes on the whole image, or f and g share a curve, as special designs make them) other
+        combinations, until the
         resultant is not identically zero; where every pair shares a curve, the regular part of
         the first pair's pencil. The pair with the fewest roots is tried first (special designs
         give the images more factors 1 + u²: two parallel axes halve their bidegrees). Returns
@@ -627,8 +636,9 @@ class _Elimination:
         a, b = next((ab for ab in self._tries(True) if min(self.shapes[ab[0] + 1][0], self.shapes[ab[1] + 1][0]) >= 2),
                     (0, 0))
         if native is not None and a < b and not np.iscomplexobj(C):
+            du, dv = self.deflatable[a, b]
             out = native.ik4_pencil(C, self.combinations[a + 1], self._factor_array(a + 1), self.combinations[b + 1],
-                                    self._factor_array(b + 1), LEAD_COND, int(self.deflatable[a, b]), DEFLATE_TOL)
+                                    self._factor_array(b + 1), LEAD_COND, int(du) + 2 * int(dv), DEFLATE_TOL)
             if out is not None:
                 f, g, M = out
                 return _eigenvalues(M), (f, g)
@@ -640,9 +650,11 @@ class _Elimination:
         tries = self._tries(np.abs(f).max() > 1e-12 * np.abs(C).max() ** 2 * np.abs(self.Qx).max())
         for a, b in tries:
             pa, pb = poly(a), poly(b)
-            if self.deflatable[a, b]:
-                deflated = _deflated(pa, pb)
-                pb = pb if deflated is None else deflated
+            du, dv = self.deflatable[a, b]
+            deflated = _deflated(pa, pb) if du else None
+            pb = pb if deflated is None else deflated
+            deflated = _deflated(pa.T, pb.T) if dv else None
+            pb = pb if deflated is None else deflated.T
             try:
                 return _hidden_variable(pa, pb, self.rng, singular_ok=False), (pa, pb)
             except _Degenerate:
@@ -929,8 +941,9 @@ def _deflated(f: np.ndarray, g: np.ndarray, tol: float = None) -> np.ndarray | N
     at least f's), where g(±i, v) = f(±i, v)·h(v) (to relative residual tol): a(u, v) = Re h(v) +
     u Im h(v), so g − a·f vanishes at u = ±i. f and g'' have the common roots of f and g except
     at u = ±i (never a displacement), and their resultant the degree of theirs less 2·deg_v f:
-    the images' pair (f, the quadric without yy) has 8 spurious roots at ±i, 48 → 40. None where
-    g(±i, ·) is no such multiple (or f(±i, ·) vanishes). In C, apair_ik4_pencil does the same."""
+    the images' pair (f, the quadric without yy) has 8 spurious roots at u_3 = ±i, 48 → 40, and,
+    transposed, 8 more where u_4 = ±i, 40 → 32. None where g(±i, ·) is no such multiple (or
+    f(±i, ·) vanishes). In C, apair_ik4_pencil does the same."""
     tol = DEFLATE_TOL if tol is None else tol
     df, dg = f.shape[1] - 1, g.shape[1] - 1
     if dg < df or f.shape[0] < 1:
