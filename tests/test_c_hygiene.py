@@ -360,3 +360,89 @@ def test_a_program_links_only_the_kernels_it_calls(tmp_path):
         defined = sorted(line.split()[-1] for line in symbols.splitlines() if " T apair_" in line)
         assert defined == sorted(expected)
         assert exe.stat().st_size < 200_000
+
+
+def c_array(name: str, a, ctype: str = "double") -> str:
+    import numpy as np
+
+    flat = np.asarray(a).ravel()
+    body = ", ".join(repr(float(x)) if ctype == "double" else str(int(x)) for x in flat) or "0"
+    return f"static const {ctype} {name}[{max(len(flat), 1)}] = {{{body}}};"
+
+
+def test_ik4_kernels_under_sanitizers(tmp_path):
+    """apair_ik4_pencil, apair_ik4_screen and apair_ik4_left on one pose of a random 4A design,
+    built with ASan and UBSan: no finding, and the numbers of the runtime's own build."""
+    import numpy as np
+
+    import apair
+    from apair import ik
+
+    native = ik._native()
+    if native is None:
+        pytest.skip("the compiled C kernels are not installed")
+    if not sanitizers_link("gcc", tmp_path):
+        pytest.skip("gcc has no sanitizer runtime here")
+    rng = np.random.default_rng(12)
+    pairs = [apair.APair(*rng.uniform(0.05, 0.12, 2)) for _ in range(4)]
+    chain = apair.AChain(pairs, rng.uniform(0.1, 0.5, 4), rng.uniform(-1.5, 1.5, 4), rng.uniform(-0.2, 0.2, 4))
+    solver = ik.Solver(chain)
+    elim = solver._elimination(False)
+    q = rng.uniform(-np.pi, np.pi, 4)
+    target = ik._study(chain.fk(q))
+    target[4:] /= solver.scale
+    if elim.pre is not None:
+        target = ik.multiply(elim.pre, ik.conjugate(target))
+    C = np.ascontiguousarray(elim.image @ ik._left(target).T)
+    a, b = elim._tries(True)[0]
+    Qf, Qg = elim.combinations[a + 1], elim.combinations[b + 1]
+    af, ag = elim._factor_array(a + 1), elim._factor_array(b + 1)
+    f, g, M = native.ik4_pencil(C, Qf, af, Qg, ag, ik.LEAD_COND, 3, ik.DEFLATE_TOL)
+    u3 = np.linalg.eigvals(M)
+    u3 = np.sort(u3[np.abs(u3.imag) <= 1e-6].real)
+    N = f.shape[1] + g.shape[1] - 2
+    screen = native.ik4_screen(u3, C, f, g, elim.Q, ik._PROBE[:N], ik._SCREEN_TOL)
+    W = screen[2][screen[0] == 0]
+    j2 = elim.joints[1]
+    joint = np.array([0.0, j2.delta, j2.offset, j2.sign])
+    left = native.ik4_left(W, elim.Zmap, j2.P, joint, ik.LEFT_TOL)
+    assert len(W) >= 1 and np.all(left[0] != 1)
+    d3, d4 = C.shape[0] - 1, C.shape[1] - 1
+    src = "\n".join([
+        '#include <stdio.h>', '#include "apair.h"',
+        c_array("C", C), c_array("Qf", Qf), c_array("Qg", Qg), c_array("af", af, "int"), c_array("ag", ag, "int"),
+        c_array("u3", u3), c_array("Q", elim.Q), c_array("probe", ik._PROBE[:N]), c_array("stol", ik._SCREEN_TOL),
+        c_array("W", W), c_array("Zmap", elim.Zmap), c_array("P2", j2.P), c_array("joint", joint),
+        c_array("ltol", ik.LEFT_TOL),
+        "static double f[289], g[289], M[512 * 512], u4[64], Wo[512], rel[64], u1[64], u2[128];",
+        "static int status[64], lstatus[64], ok[128];",
+        "/* these kernels use no other: the registry stays out of this build */",
+        "const apair_kernel *apair_find_kernel(const char *name) { (void)name; return NULL; }",
+        "int main(void) {",
+        "    int size = 0, i;",
+        f"    if (apair_ik4_pencil({d3}, {d4}, C, Qf, af, Qg, ag, {ik.LEAD_COND!r}, 3, {ik.DEFLATE_TOL!r}, f, g, M, &size)) return 1;",
+        '    printf("size %d\\nM", size);',
+        '    for (i = 0; i < size * size; i++) printf(" %.17g", M[i]);',
+        f"    if (apair_ik4_screen({len(u3)}, u3, {d3}, {d4}, C, f, {f.shape[0] - 1}, {f.shape[1] - 1}, g, "
+        f"{g.shape[0] - 1}, {g.shape[1] - 1}, {len(elim.Q)}, Q, probe, stol, status, u4, Wo, rel)) return 2;",
+        f'    printf("\\nu4"); for (i = 0; i < {len(u3)}; i++) printf(" %.17g", u4[i]);',
+        f'    printf("\\nstatus"); for (i = 0; i < {len(u3)}; i++) printf(" %d", status[i]);',
+        f"    if (apair_ik4_left({len(W)}, W, {elim.Zmap.shape[0] - 1}, Zmap, {j2.P.shape[0] - 1}, P2, joint, ltol, "
+        "lstatus, u1, u2, ok)) return 3;",
+        f'    printf("\\nu1"); for (i = 0; i < {len(W)}; i++) printf(" %.17g", u1[i]);',
+        f'    printf("\\nu2"); for (i = 0; i < {2 * len(W)}; i++) printf(" %.17g", u2[i]);',
+        '    printf("\\n");', "    return 0;", "}", ""])
+    prog = tmp_path / "ik4.c"
+    prog.write_text(src)
+    exe = tmp_path / "ik4"
+    run(["gcc", "-std=c99", *STRICT, "-O1", *SANITIZE, f"-I{CDIR}", str(prog), str(CDIR / "apair_ik.c"), "-lm",
+         "-o", str(exe)])
+    res = run([str(exe)], env={**os.environ, **SAN_ENV})
+    assert res.stderr == ""
+    out = {line.split()[0]: line.split()[1:] for line in res.stdout.splitlines()}
+    assert int(out["size"][0]) == len(M)
+    np.testing.assert_allclose(np.array(out["M"], float).reshape(M.shape), M, rtol=1e-12, atol=1e-12 * np.abs(M).max())
+    np.testing.assert_allclose(np.array(out["u4"], float), screen[1], rtol=1e-9, atol=1e-12)
+    assert [int(s) for s in out["status"]] == screen[0].tolist()
+    np.testing.assert_allclose(np.array(out["u1"], float), left[1], rtol=1e-10)
+    np.testing.assert_allclose(np.array(out["u2"], float), left[2].ravel(), rtol=1e-10)
