@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 0c8beb2c00656460
+Content hash: ed7cba9e46ff1468
 """
