@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: ed7cba9e46ff1468
+Content hash: f53197dd22b7e472
 """

@@ -388,20 +388,23 @@ def test_ik4_kernels_under_sanitizers(tmp_path):
     chain = apair.AChain(pairs, rng.uniform(0.1, 0.5, 4), rng.uniform(-1.5, 1.5, 4), rng.uniform(-0.2, 0.2, 4))
     solver = ik.Solver(chain)
     elim = solver._elimination(False)
-    q = rng.uniform(-np.pi, np.pi, 4)
-    target = ik._study(chain.fk(q))
-    target[4:] /= solver.scale
-    if elim.pre is not None:
-        target = ik.multiply(elim.pre, ik.conjugate(target))
-    C = np.ascontiguousarray(elim.image @ ik._left(target).T)
     a, b = elim._tries(True)[0]
     Qf, Qg = elim.combinations[a + 1], elim.combinations[b + 1]
     af, ag = elim._factor_array(a + 1), elim._factor_array(b + 1)
-    f, g, M = native.ik4_pencil(C, Qf, af, Qg, ag, ik.LEAD_COND, 3, ik.DEFLATE_TOL)
-    u3 = np.linalg.eigvals(M)
-    u3 = np.sort(u3[np.abs(u3.imag) <= 1e-6].real)
-    N = f.shape[1] + g.shape[1] - 2
-    screen = native.ik4_screen(u3, C, f, g, elim.Q, ik._PROBE[:N], ik._SCREEN_TOL)
+    for _ in range(100):  # a pose whose screen meets a two-dimensional null space too (status 3)
+        target = ik._study(chain.fk(rng.uniform(-np.pi, np.pi, 4)))
+        target[4:] /= solver.scale
+        if elim.pre is not None:
+            target = ik.multiply(elim.pre, ik.conjugate(target))
+        C = np.ascontiguousarray(elim.image @ ik._left(target).T)
+        f, g, M = native.ik4_pencil(C, Qf, af, Qg, ag, ik.LEAD_COND, 3, ik.DEFLATE_TOL)
+        u3 = np.linalg.eigvals(M)
+        u3 = np.sort(u3[np.abs(u3.imag) <= 1e-6].real)
+        N = f.shape[1] + g.shape[1] - 2
+        screen = native.ik4_screen(u3, C, f, g, elim.Q, ik._PROBE[:N], ik._SCREEN_TOL)
+        if np.any(screen[0] == 3) and np.any(screen[0] == 0):
+            break
+    assert np.any(screen[0] == 3)
     W = screen[2][screen[0] == 0]
     j2 = elim.joints[1]
     joint = np.array([0.0, j2.delta, j2.offset, j2.sign])
@@ -415,7 +418,8 @@ def test_ik4_kernels_under_sanitizers(tmp_path):
         c_array("W", W), c_array("Zmap", elim.Zmap), c_array("P2", j2.P), c_array("joint", joint),
         c_array("ltol", ik.LEFT_TOL),
         "static double f[289], g[289], M[512 * 512], u4[64], Wo[512], rel[64], u1[64], u2[128];",
-        "static int status[64], lstatus[64], ok[128];",
+        "static double two[256], W2[1024], rel2[128];",
+        "static int status[64], lstatus[64], ok[128], two_ok[128];",
         "/* these kernels use no other: the registry stays out of this build */",
         "const apair_kernel *apair_find_kernel(const char *name) { (void)name; return NULL; }",
         "int main(void) {",
@@ -424,7 +428,10 @@ def test_ik4_kernels_under_sanitizers(tmp_path):
         '    printf("size %d\\nM", size);',
         '    for (i = 0; i < size * size; i++) printf(" %.17g", M[i]);',
         f"    if (apair_ik4_screen({len(u3)}, u3, {d3}, {d4}, C, f, {f.shape[0] - 1}, {f.shape[1] - 1}, g, "
-        f"{g.shape[0] - 1}, {g.shape[1] - 1}, {len(elim.Q)}, Q, probe, stol, status, u4, Wo, rel)) return 2;",
+        f"{g.shape[0] - 1}, {g.shape[1] - 1}, {len(elim.Q)}, Q, probe, stol, status, u4, Wo, rel, two, two_ok, W2, rel2))"
+        " return 2;",
+        f'    printf("\\ntwo"); for (i = 0; i < {4 * len(u3)}; i++) printf(" %.17g", two[i]);',
+        f'    printf("\\nrel2"); for (i = 0; i < {2 * len(u3)}; i++) printf(" %.17g", rel2[i]);',
         f'    printf("\\nu4"); for (i = 0; i < {len(u3)}; i++) printf(" %.17g", u4[i]);',
         f'    printf("\\nstatus"); for (i = 0; i < {len(u3)}; i++) printf(" %d", status[i]);',
         f"    if (apair_ik4_left({len(W)}, W, {elim.Zmap.shape[0] - 1}, Zmap, {j2.P.shape[0] - 1}, P2, joint, ltol, "
@@ -444,5 +451,7 @@ def test_ik4_kernels_under_sanitizers(tmp_path):
     np.testing.assert_allclose(np.array(out["M"], float).reshape(M.shape), M, rtol=1e-12, atol=1e-12 * np.abs(M).max())
     np.testing.assert_allclose(np.array(out["u4"], float), screen[1], rtol=1e-9, atol=1e-12)
     assert [int(s) for s in out["status"]] == screen[0].tolist()
+    np.testing.assert_allclose(np.array(out["two"], float), screen[4].ravel(), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(np.array(out["rel2"], float), screen[7].ravel(), rtol=1e-6, atol=1e-15)
     np.testing.assert_allclose(np.array(out["u1"], float), left[1], rtol=1e-10)
     np.testing.assert_allclose(np.array(out["u2"], float), left[2].ravel(), rtol=1e-10)

@@ -461,8 +461,8 @@ def test_compiled_4_joint_steps_agree_with_numpy(monkeypatch):
             monkeypatch.setattr(ik, "_native", native if engine == "c" else (lambda: None))
             chain._ik = None
             answers[engine] = [chain.ik(chain.fk(q)) for q in qs]
-        for a, b in zip(answers["c"], answers["numpy"]):
-            assert a.shape == b.shape and np.allclose(a, b, atol=1e-8)
+        for a, b in zip(answers["c"], answers["numpy"]):  # as sets (twins at ±π may swap places)
+            assert a.shape == b.shape and all(contains(b, x, periods(chain)) for x in a)
     assert compared >= 5 and lefts_compared >= 12
 
 

@@ -796,22 +796,23 @@ done:
  * -> (f, g, M), or None where the leading coefficients are ill-conditioned */
 static PyObject *native_ik4_pencil(PyObject *self, PyObject *args)
 {
-    PyObject *o[6];
-    PyArrayObject *a[6] = {NULL};
+    PyObject *o[5];
+    PyArrayObject *a[5] = {NULL};
     PyObject *result = NULL;
     double cond_max, deflate_tol;
     int deflate;
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOdid", &o[0], &o[2], &o[3], &o[4], &o[5], &cond_max, &deflate, &deflate_tol)) {
+    if (!PyArg_ParseTuple(args, "OOOOOdid", &o[0], &o[1], &o[2], &o[3], &o[4], &cond_max, &deflate, &deflate_tol)) {
         return NULL;
     }
     npy_intp s_img[3] = {-1, -1, 8}, s_Q[2] = {8, 8}, s_a[1] = {2};
-    if (!(a[0] = ik_array(o[0], NPY_DOUBLE, 3, s_img, "C")) || !(a[2] = ik_array(o[2], NPY_DOUBLE, 2, s_Q, "Qf")) || !(a[3] = ik_array(o[3], NPY_INT32, 1, s_a, "af")) ||
-        !(a[4] = ik_array(o[4], NPY_DOUBLE, 2, s_Q, "Qg")) || !(a[5] = ik_array(o[5], NPY_INT32, 1, s_a, "ag"))) {
+    if (!(a[0] = ik_array(o[0], NPY_DOUBLE, 3, s_img, "C")) || !(a[1] = ik_array(o[1], NPY_DOUBLE, 2, s_Q, "Qf")) ||
+        !(a[2] = ik_array(o[2], NPY_INT32, 1, s_a, "af")) || !(a[3] = ik_array(o[3], NPY_DOUBLE, 2, s_Q, "Qg")) ||
+        !(a[4] = ik_array(o[4], NPY_INT32, 1, s_a, "ag"))) {
         goto done;
     }
     int d3 = (int)PyArray_DIM(a[0], 0) - 1, d4 = (int)PyArray_DIM(a[0], 1) - 1;
-    const int *af = (const int *)PyArray_DATA(a[3]), *ag = (const int *)PyArray_DATA(a[5]);
+    const int *af = (const int *)PyArray_DATA(a[2]), *ag = (const int *)PyArray_DATA(a[4]);
     npy_intp s_f[2] = {2 * d3 - 2 * af[0] + 1, 2 * d4 - 2 * af[1] + 1};
     npy_intp s_g[2] = {2 * d3 - 2 * ag[0] + 1, 2 * d4 - 2 * ag[1] + 1};
     if (deflate & 1) { /* (g - a f) / (1 + u3^2): degree max(G0, F0 + 1) - 2 in u3 */
@@ -833,7 +834,7 @@ static PyObject *native_ik4_pencil(PyObject *self, PyObject *args)
         goto done;
     }
     int size = 0;
-    int rc = apair_ik4_pencil(d3, d4, PyArray_DATA(a[0]), PyArray_DATA(a[2]), af, PyArray_DATA(a[4]), ag, cond_max,
+    int rc = apair_ik4_pencil(d3, d4, PyArray_DATA(a[0]), PyArray_DATA(a[1]), af, PyArray_DATA(a[3]), ag, cond_max,
                               deflate, deflate_tol, PyArray_DATA(f), PyArray_DATA(g), PyArray_DATA(M), &size);
     if (rc < 0) {
         PyErr_SetString(PyExc_ValueError, "ik4_pencil: degrees out of range");
@@ -848,16 +849,16 @@ static PyObject *native_ik4_pencil(PyObject *self, PyObject *args)
     }
     result = Py_BuildValue("NNN", f, g, M);
 done:
-    for (int i = 0; i < 6; i++) Py_XDECREF(a[i]);
+    for (int i = 0; i < 5; i++) Py_XDECREF(a[i]);
     return result;
 }
 
 /* ik4_screen(u3 (r), C (d3+1, d4+1, 8), f, g, Q (nq, 8, 8), probe (N), tol (3))
- * -> (status (r), u4 (r), W (r, 8), rel (r)) */
+ * -> (status (r), u4 (r), W (r, 8), rel (r), two (r, 2, 2), two_ok (r, 2), W2 (r, 2, 8), rel2 (r, 2)) */
 static PyObject *native_ik4_screen(PyObject *self, PyObject *args)
 {
     PyObject *o[7];
-    PyArrayObject *a[7] = {NULL};
+    PyArrayObject *a[7] = {NULL}, *out[8] = {NULL};
     PyObject *result = NULL;
     (void)self;
     if (!PyArg_ParseTuple(args, "OOOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &o[6])) {
@@ -872,27 +873,27 @@ static PyObject *native_ik4_screen(PyObject *self, PyObject *args)
     int F1 = (int)PyArray_DIM(a[2], 1) - 1, G1 = (int)PyArray_DIM(a[3], 1) - 1;
     npy_intp s_probe[1] = {F1 + G1};
     if (!(a[5] = ik_array(o[5], NPY_DOUBLE, 1, s_probe, "probe"))) goto done;
-    npy_intp count = PyArray_DIM(a[0], 0), s_W[2] = {count, 8};
-    PyArrayObject *status = (PyArrayObject *)PyArray_SimpleNew(1, s_W, NPY_INT32);
-    PyArrayObject *u4 = (PyArrayObject *)PyArray_SimpleNew(1, s_W, NPY_DOUBLE);
-    PyArrayObject *W = (PyArrayObject *)PyArray_SimpleNew(2, s_W, NPY_DOUBLE);
-    PyArrayObject *rel = (PyArrayObject *)PyArray_SimpleNew(1, s_W, NPY_DOUBLE);
-    if (!status || !u4 || !W || !rel) {
-        Py_XDECREF(status); Py_XDECREF(u4); Py_XDECREF(W); Py_XDECREF(rel);
-        goto done;
+    npy_intp r = PyArray_DIM(a[0], 0);
+    npy_intp shapes[8][3] = {{r}, {r}, {r, 8}, {r}, {r, 2, 2}, {r, 2}, {r, 2, 8}, {r, 2}};
+    int nds[8] = {1, 1, 2, 1, 3, 2, 3, 2};
+    int types[8] = {NPY_INT32, NPY_DOUBLE, NPY_DOUBLE, NPY_DOUBLE, NPY_DOUBLE, NPY_INT32, NPY_DOUBLE, NPY_DOUBLE};
+    for (int k = 0; k < 8; k++) {
+        if (!(out[k] = (PyArrayObject *)PyArray_SimpleNew(nds[k], shapes[k], types[k]))) goto done;
     }
-    int rc = apair_ik4_screen((size_t)count, PyArray_DATA(a[0]), (int)PyArray_DIM(a[1], 0) - 1,
+    int rc = apair_ik4_screen((size_t)r, PyArray_DATA(a[0]), (int)PyArray_DIM(a[1], 0) - 1,
                               (int)PyArray_DIM(a[1], 1) - 1, PyArray_DATA(a[1]), PyArray_DATA(a[2]),
                               (int)PyArray_DIM(a[2], 0) - 1, F1, PyArray_DATA(a[3]), (int)PyArray_DIM(a[3], 0) - 1, G1,
                               (int)PyArray_DIM(a[4], 0), PyArray_DATA(a[4]), PyArray_DATA(a[5]), PyArray_DATA(a[6]),
-                              PyArray_DATA(status), PyArray_DATA(u4), PyArray_DATA(W), PyArray_DATA(rel));
+                              PyArray_DATA(out[0]), PyArray_DATA(out[1]), PyArray_DATA(out[2]), PyArray_DATA(out[3]),
+                              PyArray_DATA(out[4]), PyArray_DATA(out[5]), PyArray_DATA(out[6]), PyArray_DATA(out[7]));
     if (rc) {
         PyErr_SetString(PyExc_ValueError, "ik4_screen: the Sylvester size is out of range");
-        Py_DECREF(status); Py_DECREF(u4); Py_DECREF(W); Py_DECREF(rel);
         goto done;
     }
-    result = Py_BuildValue("NNNN", status, u4, W, rel);
+    result = Py_BuildValue("NNNNNNNN", out[0], out[1], out[2], out[3], out[4], out[5], out[6], out[7]);
+    for (int k = 0; k < 8; k++) out[k] = NULL; /* owned by the result now */
 done:
+    for (int k = 0; k < 8; k++) Py_XDECREF(out[k]);
     for (int i = 0; i < 7; i++) Py_XDECREF(a[i]);
     return result;
 }
@@ -951,7 +952,7 @@ static PyMethodDef native_methods[] = {
     {"ik4_pencil", native_ik4_pencil, METH_VARARGS,
      "ik4_pencil(C, Qf, af, Qg, ag, cond_max, deflate, deflate_tol) -> (f, g, M) or None: apair_ik4_pencil."},
     {"ik4_screen", native_ik4_screen, METH_VARARGS,
-     "ik4_screen(u3, C, f, g, Q, probe, tol) -> (status, u4, W, rel): apair_ik4_screen."},
+     "ik4_screen(u3, C, f, g, Q, probe, tol) -> (status, u4, W, rel, two, two_ok, W2, rel2): apair_ik4_screen."},
     {"ik4_left", native_ik4_left, METH_VARARGS,
      "ik4_left(W, Zmap, P2, joint, tol) -> (status, u1, u2, ok): apair_ik4_left."},
     {"ik_local", native_ik_local, METH_VARARGS,

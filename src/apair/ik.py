@@ -686,10 +686,14 @@ class _Elimination:
             return none
         vand_tol, accept_tol, reject_tol = SCREEN_TOL
         native = _native()
-        if native is not None:  # in C (apair_ik4_screen)
+        if native is not None:  # in C (apair_ik4_screen), the same steps
             N = pair[0].shape[1] + pair[1].shape[1] - 2
-            status, u4, W, rel = native.ik4_screen(u3s, C, pair[0], pair[1], self.Q, _PROBE[:N], _SCREEN_TOL)
-            vandermonde = status != 3
+            status, u4, W, rel, two, two_ok, W2, rel2 = native.ik4_screen(u3s, C, pair[0], pair[1], self.Q,
+                                                                           _PROBE[:N], _SCREEN_TOL)
+            vandermonde = status <= 2
+            rows = np.flatnonzero(~vandermonde)
+            known, real = status[rows] == 3, two_ok[rows].astype(bool)
+            a, b, W2, rel2 = two[rows, :, 0], two[rows, :, 1], W2[rows], rel2[rows]
         else:
             x = _null_vectors(_sylvester_at(*pair, u3s))
             solved = np.isfinite(x).all(axis=1)
@@ -697,26 +701,24 @@ class _Elimination:
             vandermonde = solved & (np.linalg.norm(x[:, 1:] - u4[:, None] * x[:, :-1], axis=1) <= vand_tol)
             u4 = np.where(solved, u4, 0.0)
             W, rel = self._on_quadrics(u3s, u4, C)
+            rows = np.flatnonzero(~vandermonde)
+            # two roots u_4: each real one polished on the eliminated pair
+            v = _two_roots(_sylvester_at(*pair, u3s[rows]))
+            known = np.isfinite(v).all(axis=1)
+            real = known[:, None] & (np.abs(v.imag) <= 1e-2 * (1 + np.abs(v)))
+            a, b = np.zeros(real.shape), np.zeros(real.shape)
+            a[real], b[real] = _polished(*pair, np.repeat(u3s[rows], 2)[real.ravel()], v.real[real])
+            W2, rel2 = np.zeros(real.shape + (8,)), np.zeros(real.shape)
+            W2[real], rel2[real] = self._on_quadrics(a[real], b[real], C)
         accept, reject = vandermonde & (rel <= accept_tol), vandermonde & ~(rel <= reject_tol)
         pairs, images = np.stack([u3s[accept], u4[accept]], 1), W[accept]
-        rows = np.flatnonzero(~vandermonde)
         if len(rows) == 0:
             return pairs, images, u3s[~(accept | reject)]
-        # two roots u_4: each polished on the eliminated pair and tested; u_3 is decided where
-        # both are (complex ones are not solutions)
-        v = _two_roots(_sylvester_at(*pair, u3s[rows]))
-        known = np.isfinite(v).all(axis=1)
-        rows, v = rows[known], v[known]
-        real = np.abs(v.imag) <= 1e-2 * (1 + np.abs(v))
-        r2, v2 = np.repeat(rows, 2)[real.ravel()], v.real.ravel()[real.ravel()]
-        a, b = _polished(*pair, u3s[r2], v2)
-        W2, rel2 = self._on_quadrics(a, b, C)
-        good, bad = rel2 <= accept_tol, ~(rel2 <= reject_tol)
-        undecided = np.zeros(len(u3s), bool)
-        undecided[r2[~(good | bad)]] = True
-        decided = np.zeros(len(u3s), bool)
-        decided[rows] = True
-        reject |= decided & ~undecided
+        # a u_3 with two roots is decided where both real ones are (complex ones are no solutions);
+        # a null space that says neither leaves it undecided
+        good, bad = real & (rel2 <= accept_tol), real & ~(rel2 <= reject_tol)
+        undecided = ~known | np.any(real & ~(good | bad), axis=1)
+        reject[rows[~undecided]] = True
         pairs = np.concatenate([pairs, np.stack([a[good], b[good]], 1)])
         images = np.concatenate([images, W2[good]])
         return pairs, images, u3s[~(accept | reject)]
