@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: f53197dd22b7e472
+Content hash: e62a36bd01c09138
 """

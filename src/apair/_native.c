@@ -668,6 +668,63 @@ done:
     return result;
 }
 
+/* ik_track_slice(kind, pair, dh, p, w, ell, dell, t0, dt, times_lambda, gamma, start) -> (end, status, steps, cond) */
+static PyObject *native_ik_track_slice(PyObject *self, PyObject *args)
+{
+    PyObject *o[8];
+    PyArrayObject *a[8] = {NULL};
+    PyObject *result = NULL;
+    Py_complex t0, dt, gamma;
+    int times_lambda;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOOODDpDO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &o[6], &t0, &dt,
+                          &times_lambda, &gamma, &o[7])) {
+        return NULL;
+    }
+    npy_intp s_kind[1] = {6}, s_pair[2] = {6, 2}, s_dh[2] = {6, 4}, s_p[1] = {7}, s_ell[2] = {2, 6}, s_start[2] = {-1, 7};
+    if (!(a[0] = ik_array(o[0], NPY_INT32, 1, s_kind, "kind")) || !(a[1] = ik_array(o[1], NPY_DOUBLE, 2, s_pair, "pair")) ||
+        !(a[2] = ik_array(o[2], NPY_DOUBLE, 2, s_dh, "dh")) || !(a[3] = ik_array(o[3], NPY_CDOUBLE, 1, s_p, "p")) ||
+        !(a[4] = ik_array(o[4], NPY_CDOUBLE, 1, s_p, "w")) || !(a[5] = ik_array(o[5], NPY_CDOUBLE, 2, s_ell, "ell")) ||
+        !(a[6] = ik_array(o[6], NPY_CDOUBLE, 2, s_ell, "dell")) || !(a[7] = ik_array(o[7], NPY_CDOUBLE, 2, s_start, "start"))) {
+        goto done;
+    }
+    npy_intp count = PyArray_DIM(a[7], 0), s_out[2] = {count, 7};
+    PyArrayObject *end = (PyArrayObject *)PyArray_SimpleNew(2, s_out, NPY_CDOUBLE);
+    PyArrayObject *status = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
+    PyArrayObject *steps = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
+    PyArrayObject *cond = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_DOUBLE);
+    if (!end || !status || !steps || !cond) {
+        Py_XDECREF(end); Py_XDECREF(status); Py_XDECREF(steps); Py_XDECREF(cond);
+        goto done;
+    }
+    apair_ik_problem pb = {6, (const int *)PyArray_DATA(a[0]), PyArray_DATA(a[1]), PyArray_DATA(a[2])};
+    apair_ik_slice sl;
+    memcpy(sl.p, PyArray_DATA(a[3]), sizeof sl.p);
+    memcpy(sl.w, PyArray_DATA(a[4]), sizeof sl.w);
+    memcpy(sl.ell, PyArray_DATA(a[5]), sizeof sl.ell);
+    memcpy(sl.dell, PyArray_DATA(a[6]), sizeof sl.dell);
+    sl.t0[0] = t0.real; sl.t0[1] = t0.imag;
+    sl.dt[0] = dt.real; sl.dt[1] = dt.imag;
+    sl.times_lambda = times_lambda;
+    apair_ik_options opt;
+    apair_ik_default_options(&opt);
+    double g[2] = {gamma.real, gamma.imag};
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = apair_ik_track_slice(&pb, &opt, &sl, g, (size_t)count, PyArray_DATA(a[7]), PyArray_DATA(end),
+                              PyArray_DATA(status), PyArray_DATA(steps), PyArray_DATA(cond));
+    Py_END_ALLOW_THREADS
+    if (rc) {
+        PyErr_SetString(PyExc_ValueError, "ik_track_slice: the problem is not valid (kinds 0 or 1, 6 joints)");
+        Py_DECREF(end); Py_DECREF(status); Py_DECREF(steps); Py_DECREF(cond);
+        goto done;
+    }
+    result = Py_BuildValue("NNNN", end, status, steps, cond);
+done:
+    for (int i = 0; i < 8; i++) Py_XDECREF(a[i]);
+    return result;
+}
+
 /* ik6r_angles(x3, vec, P, L, sigma, dh, T) -> theta */
 static PyObject *native_ik6r_angles(PyObject *self, PyObject *args)
 {
@@ -943,6 +1000,9 @@ static PyMethodDef native_methods[] = {
     {"names", native_names, METH_NOARGS, "names() -> the kernel names, in registry (index) order."},
     {"enable", native_enable, METH_O, "enable(flag): whether Chain.call may evaluate (the C backend is in use)."},
     {"kernel_address", native_kernel_address, METH_O, "kernel_address(index) -> address of the registry entry."},
+    {"ik_track_slice", native_ik_track_slice, METH_VARARGS,
+     "ik_track_slice(kind, pair, dh, p, w, ell, dell, t0, dt, times_lambda, gamma, start) -> (end, status, steps, cond): "
+     "apair_ik_track_slice."},
     {"ik_track", native_ik_track, METH_VARARGS,
      "ik_track(kind, pair, dh, p0, p1, gamma, start) -> (end, status, steps, cond): apair_ik_track."},
     {"ik6r_angles", native_ik6r_angles, METH_VARARGS,

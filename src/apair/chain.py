@@ -367,16 +367,21 @@ class AChain:
             inside = inside[inside]
         return dataclasses.replace(sol, inside=inside) if full else sol.q
 
-    def prepare_ik(self, progress=None, refresh: bool = False):
+    def prepare_ik(self, progress=None, refresh: bool = False, trace: bool = False):
         """n = 5, 6: the design's homotopy start system (every complex solution at a generic complex
         pose, by monodromy), from the cache or computed now and cached (`apair ik-prepare`).
-        Returns `apair.homotopy.StartSystem` (.count, .certified, .runs, .loops, .seconds)."""
+        trace: also run the trace test (apair.trace; minutes for hundreds of solutions), whose
+        verdict is cached with the set and becomes its `certified`.
+        Returns `apair.homotopy.StartSystem` (.count, .certified, .runs, .loops, .seconds, .trace)."""
         from . import homotopy
 
         if self.n < 5:
             raise ValueError(f"chain: start systems are for 5 and 6 joints (this chain has {self.n}; its ik is "
                              "solved by elimination)")
-        return homotopy.start_system(homotopy.Problem.of(self), progress=progress, refresh=refresh)
+        certify = None
+        if trace:
+            from .trace import certify
+        return homotopy.start_system(homotopy.Problem.of(self), progress=progress, refresh=refresh, certify=certify)
 
     def ik_local(self, T, q0, tol: float = 1e-10, max_iter: int = 100):
         """The solution nearest (in the damped least-squares sense) to each seed: Levenberg-Marquardt

@@ -41,7 +41,7 @@ def _show_ik_counts(args) -> int:
           "R: R-pair; a pattern and its reverse have the same count). n < 6: at a pose of the chain's own\n"
           "image. Computed by apair.ikcounts (make ik-counts) with the homotopy machinery of chain.ik;\n"
           "'how' lists the start set's monodromy runs (for n < 6 the 6-joint set with virtual joints);\n"
-          "certified: two runs found the count (a numerical check, not a proof).")
+          "certified: by the trace test where 'how' names one, else two runs found the count (weaker).")
     print(f"{'pattern':8s} {'count':>6s}  {'certified':9s}  how")
     for r in rows:
         print(f"{r['pattern']:8s} {r['count']:6d}  {'yes' if r['certified'] else 'no':9s}  {r['how']}")
@@ -56,11 +56,16 @@ def _cmd_ik_prepare(args) -> int:
     progress = None
     if not args.quiet:
         def progress(loops, count):
-            print(f"\rmonodromy: loop {loops:4d}, {count:6d} solutions", end="", file=sys.stderr, flush=True)
-    start = chain.prepare_ik(progress=progress, refresh=args.refresh)
+            print(f"\rmonodromy: loop {loops:4d}, {count:6d} points", end="", file=sys.stderr, flush=True)
+    start = chain.prepare_ik(progress=progress, refresh=args.refresh, trace=args.trace)
     if progress:
         print(file=sys.stderr)
-    state = "certified" if start.certified else "NOT certified (the independent runs disagree)"
+    if start.traced:
+        state = (f"certified by the trace test (deviation {start.trace:.1e}, {start.witnesses} witnesses)"
+                 if start.certified else f"NOT complete: the trace test failed (deviation {start.trace:.1e})")
+    else:
+        state = ("certified (two monodromy runs agree; no trace test: --trace runs one)" if start.certified
+                 else "NOT certified (the independent runs disagree)")
     print(f"{chain.name}: start system of {start.count} complex solutions, {state}; runs found {start.runs} "
           f"in {start.loops} loops ({start.seconds:.1f} s to compute; cached)")
     return 0
@@ -295,6 +300,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help="a chain TOML file (5 or 6 sinusoidal A-pairs or R-pairs)")
     p.add_argument("--refresh", action="store_true", help="compute it again even if it is cached")
     p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.add_argument("--trace", action="store_true",
+                   help="also certify the set by the trace test (minutes for hundreds of solutions; cached)")
     p.set_defaults(func=_cmd_ik_prepare)
     p = sub.add_parser("limits", help="joint ranges of a chain file: explicit, or the pairs' collision limits")
     p.add_argument("file", help="a chain TOML file")

@@ -21,12 +21,13 @@ reaches all of it:
   the C kernels. Paths that fail, or land on the same endpoint as another (a path jump), are
   tracked again with a new γ. Real endpoints are the candidates; `apair.ik` verifies them with
   the fk kernel.
-- **Completeness**: a start set is `certified` when two independent monodromy runs (each from its
-  own random start, each stable for STABLE loops) found the same number, the union's, and
-  CHECK_LOOPS further loops carry every solution without losing a path; a pose's
-  answer is complete when, in addition, every path ended (finite, or diverging to infinity) at a
-  distinct point. This is a numerical check, not a proof: no trace test is run, and a solution
-  that every run misses (one far out in the complex, where paths lose digits) goes unnoticed.
+- **Completeness**: a start set is `certified` by its trace test (apair.trace, passed to
+  `start_system` as `certify`) where one has run. Otherwise it is `certified` when two
+  independent monodromy runs (each from its own random start, each stable for STABLE loops) found
+  the same number, the union's, and CHECK_LOOPS further loops carry every solution without losing a
+  path. That is weaker: a solution that every run misses (far out in the complex, where paths lose
+  digits) goes unnoticed. A pose's answer is complete when, in addition, every path ended (finite,
+  or diverging to infinity) at a distinct point.
 """
 from __future__ import annotations
 
@@ -43,7 +44,7 @@ import numpy as np
 
 from .study import from_matrix
 
-FORMAT = 1  # of the cached start systems
+FORMAT = 2  # of the cached start systems
 STABLE = 20  # loops in a row without a new solution that end a monodromy run
 MAX_LOOPS = 400
 CHECK_LOOPS = 3  # loops after the runs in which no path may be lost for a certified start set
@@ -193,19 +194,26 @@ class StartSystem:
     solutions: np.ndarray  # (k, n) complex
     loops: int  # monodromy loops run
     runs: list  # solution counts of the independent runs
-    certified: bool  # the count was stable and reproduced
+    certified: bool  # the trace test passed; without one: the count was stable and reproduced
     seconds: float
+    trace: float = math.nan  # the trace test's relative deviation from affine (apair.trace); NaN: not run
+    witnesses: int = 0  # the trace test's extra witness points
 
     @property
     def count(self) -> int:
         return len(self.solutions)
+
+    @property
+    def traced(self) -> bool:
+        """Whether a trace test has judged this set (then `certified` is its verdict)."""
+        return not math.isnan(self.trace)
 
     def save(self, path: Path) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
         with open(tmp, "wb") as f:
             np.savez(f, format=FORMAT, problem_key=self.problem_key, p0=self.p0, solutions=self.solutions, loops=self.loops, runs=np.array(self.runs),
-                     certified=self.certified, seconds=self.seconds)
+                     certified=self.certified, seconds=self.seconds, trace=self.trace, witnesses=self.witnesses)
         os.replace(tmp, path)
 
     @staticmethod
@@ -216,7 +224,7 @@ class StartSystem:
                     return None
                 return StartSystem(key, z["p0"], z["solutions"],
                                    int(z["loops"]), [int(x) for x in z["runs"]], bool(z["certified"]),
-                                   float(z["seconds"]))
+                                   float(z["seconds"]), float(z["trace"]), int(z["witnesses"]))
         except (OSError, ValueError, KeyError):
             return None
 
@@ -294,15 +302,19 @@ def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None
         return track_numpy(problem, p0, p1, gamma, start)
     args = (problem.kind, problem.pair, problem.dh, np.ascontiguousarray(p0, complex),
             np.ascontiguousarray(p1, complex), complex(gamma))
+    return threaded(lambda share: native.ik_track(*args, share), start)
+
+
+def threaded(track_share, start: np.ndarray):
+    """track_share(rows) -> (end, status, steps, cond) over the rows of start: the paths are
+    independent and the C trackers release the GIL, so one share per thread, the last one tracked
+    by the calling thread."""
     threads = min(threads_for_tracking(), len(start) // PATHS_PER_THREAD)
     if threads <= 1:
-        return native.ik_track(*args, start)
-    # the paths are independent and the C tracker releases the GIL: one share per thread, the
-    # last one tracked by the calling thread
+        return track_share(start)
     shares = np.array_split(start, threads)
-    futures = [_pool(threads - 1).submit(native.ik_track, *args, np.ascontiguousarray(share))
-               for share in shares[:-1]]
-    last = native.ik_track(*args, np.ascontiguousarray(shares[-1]))
+    futures = [_pool(threads - 1).submit(track_share, np.ascontiguousarray(share)) for share in shares[:-1]]
+    last = track_share(np.ascontiguousarray(shares[-1]))
     parts = [f.result() for f in futures] + [last]
     return tuple(np.concatenate([part[i] for part in parts]) for i in range(4))
 
@@ -396,8 +408,17 @@ def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
     the same predictor (RK4), corrector (Newton, at most `corrector_steps`, each step at most half
     the one before), step control and endpoint test. The fallback without the C kernels, and an
     independent check of the C tracker."""
+    p0, dp = np.asarray(p0, complex), np.asarray(p1, complex) - np.asarray(p0, complex)
+    return track_system(lambda x, s: _batched(problem, x, s, p0, dp), gamma, start, problem.n)
+
+
+def track_system(evaluate, gamma, start: np.ndarray, angles: int):
+    """track_numpy's tracker for any square system H(x; s) = 0 from s = 0 to 1 along the γ arc:
+    evaluate(x (k, m), s (k,)) gives H (k, m), dH/dx (k, m, m) and ∂H/∂s (k, m); the first
+    `angles` columns of x are complex joint angles (the divergence and far-out tests look at
+    them; apair.trace tracks an extra column that is not an angle). Returns (end, status, steps, cond)."""
     o = TRACK
-    p0, dp, g = np.asarray(p0, complex), np.asarray(p1, complex) - np.asarray(p0, complex), complex(gamma)
+    g = complex(gamma)
     k = len(start)
     v = np.array(start, complex)
     tau, h = np.zeros(k), np.full(k, o["initial_step"])
@@ -411,7 +432,7 @@ def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
 
     def tangent(x, t):
         s, ds = s_of(t)
-        _, J, Fs = _batched(problem, x, s, p0, dp)
+        _, J, Fs = evaluate(x, s)
         return _solve(J, -(Fs * ds[:, None]))
 
     def correct(x, t, iters, tol, kt=None):
@@ -422,7 +443,7 @@ def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
         for it in range(iters):
             if not live.any():
                 break
-            F, J, Fs = _batched(problem, x[live], s[live], p0, dp)
+            F, J, Fs = evaluate(x[live], s[live])
             d = _solve(J, -F)
             idx = np.flatnonzero(live)
             if kt is not None:
@@ -433,7 +454,7 @@ def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
             conv = dn <= tol * (1 + np.abs(x[idx]).max(1))
             ok[idx[conv]] = True
             stall = (it > 0) & (dn > 0.5 * prev[idx]) & ~conv
-            far = np.abs(x[idx].imag).max(1)
+            far = np.abs(x[idx, :angles].imag).max(1)
             ok[idx[stall & (far > 4.0) & (dn <= 1e3 * tol * (1 + np.abs(x[idx]).max(1)))]] = True
             live[idx[conv | stall]] = False
             prev[idx] = dn
@@ -471,7 +492,7 @@ def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
             grow = good[acc] >= 2
             h[acc[grow]] = np.minimum(2 * h[acc[grow]], o["max_step"])
             good[acc[grow]] = 0
-            status[acc[np.abs(v[acc].imag).max(1) > o["divergence"]]] = DIVERGED
+            status[acc[np.abs(v[acc, :angles].imag).max(1) > o["divergence"]]] = DIVERGED
             h[rej] *= 0.5
             good[rej] = 0
             status[rej[h[rej] < o["min_step"]]] = FAILED
@@ -489,10 +510,10 @@ def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
                     break
             v[fin] = x
             s, _ = s_of(np.ones(len(fin)))
-            _, J, _ = _batched(problem, x, s, p0, dp)
+            _, J, _ = evaluate(x, s)
             cond[fin] = np.linalg.cond(J, 1)
             conv = prev <= o["path_tol"] * (1 + np.abs(x).max(1))
-            out = ~np.all(np.isfinite(x), axis=1) | (np.abs(x.imag).max(1) > o["divergence"])
+            out = ~np.all(np.isfinite(x), axis=1) | (np.abs(x[:, :angles].imag).max(1) > o["divergence"])
             status[fin] = np.where(out, DIVERGED, np.where(conv & (cond[fin] <= o["singular_cond"]), OK, SINGULAR))
     return v, status.astype(np.int32), steps.astype(np.int32), cond
 
@@ -606,14 +627,20 @@ def _cache_path(problem: Problem) -> Path:
     return cache_root() / "ik" / f"{h}.npz"
 
 
-def start_system(problem: Problem, progress=None, refresh: bool = False) -> StartSystem:
-    """The design's start system from the cache, or prepared now and cached."""
+def start_system(problem: Problem, progress=None, refresh: bool = False, certify=None) -> StartSystem:
+    """The design's start system from the cache, or prepared now and cached. certify: a function
+    (problem, start) -> start run on a set that no trace test has judged yet (apair.trace.certify),
+    its verdict cached with the set."""
     path = _cache_path(problem)
+    start = None
     if not refresh and path.exists():
-        got = StartSystem.load(path, problem.key())
-        if got is not None:
-            return got
-    start = prepare(problem, progress=progress)
+        start = StartSystem.load(path, problem.key())
+        if start is not None and (certify is None or start.traced):
+            return start
+    if start is None:
+        start = prepare(problem, progress=progress)
+    if certify is not None:
+        start = certify(problem, start, progress=progress)
     try:
         start.save(path)
     except OSError:

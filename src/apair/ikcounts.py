@@ -10,9 +10,11 @@ joints at 0 at a generic pose of the chain's own (complex) image. A pattern and 
 the same count (the inverse chain: T⁻¹ = A_n⁻¹ ⋯ A_1⁻¹, an inverted pair is a pair of the same
 kind), so each pattern is computed once, under the first of the two in alphabetical order.
 
-How each count is certified ("how"): two independent monodromy runs found the same number (and
-for 6R the known 16 of Lee–Liang and Raghavan–Roth; for n ≤ 4 the eliminations of apair.ik give
-an independent count, checked by the tests). This is weaker than a trace test: counts just below
+How each count is certified ("how"): by the trace test (apair.trace) for the start sets it was
+run on (`--trace MAX_COUNT`: sets of up to MAX_COUNT solutions; its monodromy also adds any start
+solution the runs missed), otherwise by two independent monodromy runs that found the same number
+(and for 6R the known 16 of Lee–Liang and Raghavan–Roth; for n ≤ 4 the eliminations of apair.ik
+give an independent count, checked by the tests). Two agreeing runs are weaker: counts just below
 round numbers (248, 319, 511, 639, 1279, 2559) suggest solutions far out in the complex, where
 paths lose digits, that the runs miss alike.
 """
@@ -67,12 +69,18 @@ def reachable_pose(problem: homotopy.Problem, rng) -> np.ndarray:
     return p + (1.0 + 0.5j) * null / np.linalg.norm(null[3:])
 
 
-def count(pattern: str, seed: int = 0, progress=None) -> dict:
-    """The generic count of one pattern, with how it was obtained."""
+def count(pattern: str, seed: int = 0, progress=None, trace_upto: int = 0) -> dict:
+    """The generic count of one pattern, with how it was obtained; the trace test judges start
+    sets of at most trace_upto solutions."""
     t0 = time.perf_counter()
     chain = design(pattern, seed)
     problem = homotopy.Problem.of(chain)
     start = homotopy.prepare(problem, seed=seed, progress=progress)
+    traced = start.count <= trace_upto
+    if traced:
+        from .trace import certify
+
+        start = certify(problem, start)
     if chain.n == 6:
         found = start.count
     else:
@@ -88,27 +96,46 @@ def count(pattern: str, seed: int = 0, progress=None) -> dict:
                 break
         found = len(found.rows)
     how = f"monodromy: {len(start.runs)} runs found {start.runs}"
+    if traced:
+        how += (f"; trace test {'passed' if start.certified else 'FAILED'} (deviation {start.trace:.0e}, "
+                f"{start.witnesses} witnesses)")
+        certified = start.certified
+    else:
+        certified = bool(sum(r == start.count for r in start.runs) >= 2)
     if pattern in KNOWN:
         how += f"; known: {KNOWN[pattern]}"
     return {"pattern": pattern, "joints": len(pattern), "count": found, "start_count": start.count,
-            "certified": bool(sum(r == start.count for r in start.runs) >= 2 and KNOWN.get(pattern, found) == found),
+            "certified": bool(certified and KNOWN.get(pattern, found) == found), "traced": traced,
             "how": how,
             "seconds": round(time.perf_counter() - t0, 1)}
 
 
 def main(argv=None) -> int:
-    """`python -m apair.ikcounts OUT.json [MAX_N]`: every pattern's count, one line each as it goes."""
-    argv = sys.argv[1:] if argv is None else argv
-    if not argv:
-        print("usage: python -m apair.ikcounts OUT.json [MAX_N]", file=sys.stderr)
-        return 2
-    out, max_n = Path(argv[0]), int(argv[1]) if len(argv) > 1 else 6
+    """`python -m apair.ikcounts OUT.json [MAX_N] [--trace MAX_COUNT] [--update]`: every pattern's
+    count, one line each as it goes; --trace: the trace test judges start sets of at most MAX_COUNT
+    solutions; --update: only the rows of OUT.json whose start sets it judges are computed again."""
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="python -m apair.ikcounts")
+    parser.add_argument("out", type=Path)
+    parser.add_argument("max_n", type=int, nargs="?", default=6)
+    parser.add_argument("--trace", type=int, default=0, metavar="MAX_COUNT")
+    parser.add_argument("--update", action="store_true")
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    old = {}
+    if args.update:
+        old = {r["pattern"]: r for r in json.loads(args.out.read_text())["counts"]}
     rows = []
-    for p in patterns(max_n):
-        r = count(p)
+    for p in patterns(args.max_n):
+        if p in old and old[p]["start_count"] > args.trace:
+            rows.append(old[p])
+            continue
+        r = count(p, trace_upto=args.trace)
         rows.append(r)
         print(f"{p:6s} {r['count']:6d}  (start set {r['start_count']}, {r['how']}, {r['seconds']} s)", flush=True)
-        out.write_text(json.dumps({"counts": rows}, indent=1) + "\n")
+        args.out.write_text(json.dumps({"counts": rows + [old[q] for q in patterns(args.max_n)[len(rows):] if q in old]},
+                                       indent=1) + "\n")
+    args.out.write_text(json.dumps({"counts": rows}, indent=1) + "\n")
     return 0
 
 
