@@ -434,9 +434,13 @@ def random_pattern_chain(pattern: str, rng) -> apair.AChain:
                         rng.uniform(-1.0, 1.0, n))
 
 
+TRACE_MAX = 128  # start sets the bench certifies by the trace test (a 6A set's would take hours)
+
+
 def time_ik6(pattern: str, poses: int, rng) -> dict:
-    """6-joint IK: the start system's preparation (into an empty cache), then every real solution at
-    `poses` random poses: median and worst per pose, and whether each pose's solution was found."""
+    """6-joint IK: the start system's preparation (into an empty cache) and, for sets of up to
+    TRACE_MAX solutions, its trace test; then every real solution at `poses` random poses: median
+    and worst per pose, and whether each pose's solution was found."""
     chain = random_pattern_chain(pattern, rng)
     old = os.environ.get("APAIR_CACHE")
     with tempfile.TemporaryDirectory() as tmp:
@@ -445,6 +449,11 @@ def time_ik6(pattern: str, poses: int, rng) -> dict:
             t0 = time.perf_counter()
             start = chain.prepare_ik()
             prep = time.perf_counter() - t0
+            trace_s = None
+            if start.count <= TRACE_MAX:
+                t0 = time.perf_counter()
+                start = chain.prepare_ik(trace=True)
+                trace_s = time.perf_counter() - t0
             qs = rng.uniform(-np.pi, np.pi, (poses, 6))
             t0 = time.perf_counter()
             chain.ik(chain.fk(qs[0]))  # the first call loads the start system from the cache
@@ -468,6 +477,7 @@ def time_ik6(pattern: str, poses: int, rng) -> dict:
     ms = np.array(times) * 1e3
     return {"pattern": pattern, "poses": poses, "median_ms": float(np.median(ms)), "max_ms": float(ms.max()),
             "prepare_s": prep, "first_call_ms": first * 1e3, "start_count": start.count, "start_certified": start.certified,
+            "trace_s": trace_s, "trace_deviation": start.trace if start.traced else None, "witnesses": start.witnesses,
             "round_trips_found": found, "certified_poses": certified, "methods": methods}
 
 
@@ -614,8 +624,10 @@ def main(argv=None) -> int:
         print(f"  6-joint {p:24s} median {r['median_ms']:.2f} ms, worst {r['max_ms']:.2f} ms over {r['poses']} poses "
               f"({r['round_trips_found']} round trips found, {r['certified_poses']} certified; "
               + ", ".join(f"{k} {v}" for k, v in sorted(r["methods"].items())) + "); start system "
-              f"{r['start_count']} solutions ({'certified' if r['start_certified'] else 'not certified'}) prepared "
-              f"in {r['prepare_s']:.1f} s")
+              f"{r['start_count']} solutions prepared in {r['prepare_s']:.1f} s, "
+              + (f"trace test {'passed' if r['start_certified'] else 'FAILED'} in {r['trace_s']:.1f} s (deviation "
+                 f"{r['trace_deviation']:.0e}, {r['witnesses']} witnesses)" if r["trace_s"] is not None else
+                 f"no trace test ({'two runs agree' if r['start_certified'] else 'not certified'})"))
     r = results["ik_local"]
     print(f"  ik_local n = 6: {r['us_per_converged']:.2f} µs per converged solve ({r['converged']:.1%} converged)")
     if results["make_generate_s"] is not None:

@@ -54,6 +54,28 @@ def test_slice_derivatives(times_lambda):
     assert np.abs(fd[0] - Hs[0]).max() <= 1e-7 * (1 + np.abs(Hs).max())
 
 
+def test_slice_tracker_c_matches_numpy():
+    """apair_ik_track_slice and the NumPy tracker on the same slice paths: the same steps and
+    endpoints (both modes: the trace family from the start set, a hyperplane move of its images)."""
+    if homotopy._native() is None:
+        pytest.skip("the compiled C kernels are not installed")
+    problem = homotopy.Problem.of(ikcounts.design("ARRARR"))
+    start = homotopy.prepare(problem)
+    rng = np.random.default_rng(3)
+    w, ell = homotopy.random_pose(rng), 0.3 * crandn(rng, 2, 6)
+    X0 = np.concatenate([start.solutions, np.zeros((start.count, 1))], axis=1)
+    family = trace.Slice(problem, start.p0, w, ell, np.zeros_like(ell), 0, 0.7 + 0.2j, True)
+    X1, status, _, _ = family.track_once(0.8 + 0.6j, X0, engine="c")
+    z, _ = trace.coordinates(problem, X1[:, :6])
+    ell1 = ell / np.sum(ell[0] * z[0] + ell[1] / z[0])  # ℓ1 = 1 at the first point, ℓ − 1 = −0.7/λ at the others
+    move = trace.Slice(problem, start.p0, w, ell1, ell - ell1, 0, 0, False)
+    for sl, X in ((family, X0), (move, X1[:1])):
+        c = sl.track_once(0.8 + 0.6j, X, engine="c")
+        n = sl.track_once(0.8 + 0.6j, X, engine="numpy")
+        assert np.all(c[1] == homotopy.OK) and np.array_equal(c[1], n[1]) and np.array_equal(c[2], n[2])
+        assert np.abs(c[0] - n[0]).max() <= 1e-8
+
+
 def test_trace_test_decides():
     """One witness set, three start sets: the complete one passes by many orders of magnitude,
     the one short of a solution fails, and so does the complete one against the witness set short
