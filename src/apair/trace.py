@@ -8,7 +8,8 @@ in the complex can be missed by every run alike. The trace test of Leykin, Rodri
   irreducible because the solution set over all poses is; the start set S is C ∩ {λ = 0}.
 - A random affine function ℓ of the joints' algebraic coordinates z_j = exp(iθ_j/2) (A-pair; its
   pose has period 4π) or exp(iθ_j) (R-pair) and of 1/z_j cuts C in the witness points
-  W = C ∩ {ℓ = 1}, computed by monodromy: loops through random ℓ (`witness_points`).
+  W = C ∩ {ℓ = 1}, computed by monodromy (`witness_points`): loops through random ℓ, and
+  loops through the family f = −t below, which also return any start solution S lacks.
 - On C the function f = (ℓ − 1)·λ vanishes exactly on S ∪ W, and it is proper: every branch of C
   that leaves for infinity takes f with it (ℓ → ∞ where θ does, λ → ∞ otherwise). So the sum of
   the coordinates (z, 1/z, λ) over the points of {f = −t} is a polynomial in t of degree at most
@@ -21,9 +22,9 @@ e^Σ|Im θ| large and cancel, and Newton's method in double precision stalls at 
 would hide the deviation of a missing point. Such endpoints are refined by Newton's method with
 the residual evaluated at `DIGITS` digits (FLINT's acb, by the 4×4 DH product and the quaternion
 product: a route independent of the generated kernel), and the traces are summed at that precision.
-A test that passes is strong numerical evidence, not a proof; a test that fails proves the set
-incomplete (up to the accuracy of the tracked paths, whose failures make the test inconclusive and
-so fail it).
+A test that passes is strong numerical evidence, not a proof. A test that fails says that S ∪ W
+is incomplete, the start set or the witnesses (so the witness monodromy goes on and the test is
+repeated); a path that cannot be tracked leaves no verdict, which counts as a failure.
 """
 from __future__ import annotations
 
@@ -168,10 +169,8 @@ def witness_points(problem: homotopy.Problem, start: homotopy.StartSystem, rng, 
         r = 10.0 ** rng.uniform(-1.0, 1.0)  # loops of many sizes: each encircles other branch points
         if loops % T_LOOP_EVERY:
             cur = np.array(points)
-            legs = [(ell, ell + r * size * _crandn(rng, 2, 6)), None, None]
-            legs[1] = (legs[0][1], ell + r * size * _crandn(rng, 2, 6))
-            legs[2] = (legs[1][1], ell)
-            slices = [Slice(problem, start.p0, w, a, b - a, 0, 0, False) for a, b in legs]
+            la, lb = (ell + r * size * _crandn(rng, 2, 6) for _ in range(2))
+            slices = [Slice(problem, start.p0, w, a, b - a, 0, 0, False) for a, b in ((ell, la), (la, lb), (lb, ell))]
         else:
             cur = np.concatenate([np.concatenate([np.array(S), np.zeros((len(S), 1))], axis=1), np.array(points)])
             ta, tb = r * T_SCALE * _crandn(rng, 2)
