@@ -90,3 +90,13 @@ def _eval(expr, env, count):
     if not isinstance(out, np.ndarray):
         out = np.full(count, mpmath.mpf(out), dtype=object)
     return out
+
+
+def arm_toml(folder):
+    """A 6R arm's chain file (generic geometry, twists in degrees) written into folder: its path."""
+    path = folder / "arm.toml"
+    joints = "\n".join(f"[[joint]]\npair = \"revolute\"\na = {a}\nalpha_deg = {al}\noffset = {c}\n"
+                       for a, al, c in [(0.1, 90, 0.3), (0.4, 10, 0.0), (0.05, 80, 0.02), (0.0, -70, 0.4),
+                                        (0.02, 60, 0.0), (0.0, 20, 0.1)])
+    path.write_text(f"name = \"arm\"\n{joints}")
+    return path

@@ -8,6 +8,7 @@ import pytest
 
 import apair
 from apair import homotopy, ik6r
+from conftest import arm_toml
 
 PI = np.pi
 
@@ -200,11 +201,7 @@ def test_unreachable_pose_has_16_complex_and_no_real_solutions():
 def test_cli_names_the_route(tmp_path, capsys):
     from apair.cli import main as cli
 
-    path = tmp_path / "arm.toml"
-    joints = "\n".join(f"[[joint]]\npair = \"revolute\"\na = {a}\nalpha_deg = {al}\noffset = {c}\n"
-                       for a, al, c in [(0.1, 90, 0.3), (0.4, 10, 0.0), (0.05, 80, 0.02), (0.0, -70, 0.4),
-                                        (0.02, 60, 0.0), (0.0, 20, 0.1)])
-    path.write_text(f"name = \"arm\"\n{joints}")
+    path = arm_toml(tmp_path)
     chain = apair.load(path)
     q = np.array([0.3, -0.5, 0.8, 1.1, -0.4, 0.2])
     assert cli(["ik", str(path), *[repr(float(x)) for x in chain.fk(q).ravel()]]) == 0

@@ -10,6 +10,7 @@ import pytest
 import apair
 from apair import homotopy, ik1a5r, ikcounts
 from apair.cli import main as cli
+from conftest import arm_toml
 
 
 def chain_of(pattern: str, rng, special: bool = False) -> apair.AChain:
@@ -210,11 +211,7 @@ def test_refusals():
 
 
 def test_cli(tmp_path, capsys):
-    path = tmp_path / "arm.toml"
-    joints = "\n".join(f"[[joint]]\npair = \"revolute\"\na = {a}\nalpha_deg = {al}\noffset = {c}\n"
-                       for a, al, c in [(0.1, 90, 0.3), (0.4, 10, 0.0), (0.05, 80, 0.02), (0.0, -70, 0.4),
-                                        (0.02, 60, 0.0), (0.0, 20, 0.1)])
-    path.write_text(f"name = \"arm\"\n{joints}")
+    path = arm_toml(tmp_path)
     assert cli(["ik-prepare", str(path), "--quiet"]) == 0
     out = capsys.readouterr().out
     assert "start system of 16 complex solutions, certified" in out

@@ -13,6 +13,7 @@ import pytest
 import apair
 from apair import homotopy, ikcounts, trace
 from apair.cli import main as cli
+from conftest import arm_toml
 
 PI = np.pi
 
@@ -124,11 +125,7 @@ def test_special_design_is_certified():
 
 def test_verdict_is_cached_and_shown(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("APAIR_CACHE", str(tmp_path / "cache"))
-    path = tmp_path / "arm.toml"
-    joints = "\n".join(f"[[joint]]\npair = \"revolute\"\na = {a}\nalpha_deg = {al}\noffset = {c}\n"
-                       for a, al, c in [(0.1, 90, 0.3), (0.4, 10, 0.0), (0.05, 80, 0.02), (0.0, -70, 0.4),
-                                        (0.02, 60, 0.0), (0.0, 20, 0.1)])
-    path.write_text(f"name = \"arm\"\n{joints}")
+    path = arm_toml(tmp_path)
     chain = apair.load(path)
     plain = chain.prepare_ik()
     assert not plain.traced and plain.certified

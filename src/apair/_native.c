@@ -615,6 +615,30 @@ static PyArrayObject *ik_array(PyObject *obj, int type, int nd, const npy_intp *
     return a;
 }
 
+/* The trackers' outputs for s_out[0] paths of s_out[1] variables: end (complex), status, steps
+ * (int32) and cond. 0, or -1 with a Python error set. */
+static int track_outputs(const npy_intp *s_out, PyArrayObject **out)
+{
+    out[0] = (PyArrayObject *)PyArray_SimpleNew(2, s_out, NPY_CDOUBLE);
+    out[1] = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
+    out[2] = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
+    out[3] = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_DOUBLE);
+    if (out[0] && out[1] && out[2] && out[3]) return 0;
+    for (int i = 0; i < 4; i++) Py_XDECREF(out[i]);
+    return -1;
+}
+
+/* (end, status, steps, cond) of a tracker that returned rc, or NULL with an error (the outputs freed). */
+static PyObject *track_result(int rc, PyArrayObject **out, const char *what)
+{
+    if (rc) {
+        PyErr_Format(PyExc_ValueError, "%s: the problem is not valid (kinds 0 or 1, 6 joints)", what);
+        for (int i = 0; i < 4; i++) Py_DECREF(out[i]);
+        return NULL;
+    }
+    return Py_BuildValue("NNNN", out[0], out[1], out[2], out[3]);
+}
+
 /* ik_track(kind, pair, dh, p0, p1, gamma, start) -> (end, status, steps, cond) */
 static PyObject *native_ik_track(PyObject *self, PyObject *args)
 {
@@ -640,14 +664,8 @@ static PyObject *native_ik_track(PyObject *self, PyObject *args)
         goto done;
     }
     npy_intp count = PyArray_DIM(a[8], 0), s_out[2] = {count, n};
-    PyArrayObject *end = (PyArrayObject *)PyArray_SimpleNew(2, s_out, NPY_CDOUBLE);
-    PyArrayObject *status = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
-    PyArrayObject *steps = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
-    PyArrayObject *cond = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_DOUBLE);
-    if (!end || !status || !steps || !cond) {
-        Py_XDECREF(end); Py_XDECREF(status); Py_XDECREF(steps); Py_XDECREF(cond);
-        goto done;
-    }
+    PyArrayObject *out[4];
+    if (track_outputs(s_out, out)) goto done;
     apair_ik_problem pb = {(int)n, (const int *)PyArray_DATA(a[0]), PyArray_DATA(a[1]), PyArray_DATA(a[2])};
     apair_ik_options opt;
     apair_ik_default_options(&opt);
@@ -655,14 +673,9 @@ static PyObject *native_ik_track(PyObject *self, PyObject *args)
     int rc;
     Py_BEGIN_ALLOW_THREADS
     rc = apair_ik_track(&pb, &opt, PyArray_DATA(a[5]), PyArray_DATA(a[6]), g, (size_t)count, PyArray_DATA(a[8]),
-                        PyArray_DATA(end), PyArray_DATA(status), PyArray_DATA(steps), PyArray_DATA(cond));
+                        PyArray_DATA(out[0]), PyArray_DATA(out[1]), PyArray_DATA(out[2]), PyArray_DATA(out[3]));
     Py_END_ALLOW_THREADS
-    if (rc) {
-        PyErr_SetString(PyExc_ValueError, "ik_track: the problem is not valid (kinds 0 or 1, 6 joints)");
-        Py_DECREF(end); Py_DECREF(status); Py_DECREF(steps); Py_DECREF(cond);
-        goto done;
-    }
-    result = Py_BuildValue("NNNN", end, status, steps, cond);
+    result = track_result(rc, out, "ik_track");
 done:
     for (int i = 0; i < 9; i++) Py_XDECREF(a[i]);
     return result;
@@ -689,14 +702,8 @@ static PyObject *native_ik_track_slice(PyObject *self, PyObject *args)
         goto done;
     }
     npy_intp count = PyArray_DIM(a[7], 0), s_out[2] = {count, 7};
-    PyArrayObject *end = (PyArrayObject *)PyArray_SimpleNew(2, s_out, NPY_CDOUBLE);
-    PyArrayObject *status = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
-    PyArrayObject *steps = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_INT32);
-    PyArrayObject *cond = (PyArrayObject *)PyArray_SimpleNew(1, s_out, NPY_DOUBLE);
-    if (!end || !status || !steps || !cond) {
-        Py_XDECREF(end); Py_XDECREF(status); Py_XDECREF(steps); Py_XDECREF(cond);
-        goto done;
-    }
+    PyArrayObject *out[4];
+    if (track_outputs(s_out, out)) goto done;
     apair_ik_problem pb = {6, (const int *)PyArray_DATA(a[0]), PyArray_DATA(a[1]), PyArray_DATA(a[2])};
     apair_ik_slice sl;
     memcpy(sl.p, PyArray_DATA(a[3]), sizeof sl.p);
@@ -711,15 +718,10 @@ static PyObject *native_ik_track_slice(PyObject *self, PyObject *args)
     double g[2] = {gamma.real, gamma.imag};
     int rc;
     Py_BEGIN_ALLOW_THREADS
-    rc = apair_ik_track_slice(&pb, &opt, &sl, g, (size_t)count, PyArray_DATA(a[7]), PyArray_DATA(end),
-                              PyArray_DATA(status), PyArray_DATA(steps), PyArray_DATA(cond));
+    rc = apair_ik_track_slice(&pb, &opt, &sl, g, (size_t)count, PyArray_DATA(a[7]), PyArray_DATA(out[0]),
+                              PyArray_DATA(out[1]), PyArray_DATA(out[2]), PyArray_DATA(out[3]));
     Py_END_ALLOW_THREADS
-    if (rc) {
-        PyErr_SetString(PyExc_ValueError, "ik_track_slice: the problem is not valid (kinds 0 or 1, 6 joints)");
-        Py_DECREF(end); Py_DECREF(status); Py_DECREF(steps); Py_DECREF(cond);
-        goto done;
-    }
-    result = Py_BuildValue("NNNN", end, status, steps, cond);
+    result = track_result(rc, out, "ik_track_slice");
 done:
     for (int i = 0; i < 8; i++) Py_XDECREF(a[i]);
     return result;
