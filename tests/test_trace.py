@@ -89,11 +89,11 @@ def test_trace_test_decides():
     full = trace.trace_test(problem, start, witnesses=(w, ell, W, S))
     assert full.passed and full.deviation < 1e-11 and full.witnesses == len(W)
     fewer = trace.trace_test(problem, start, witnesses=(w, ell, W, S[1:]))
-    assert not fewer.passed and fewer.deviation > 100 * trace.TRACE_TOL
+    assert not fewer.passed and fewer.deviation > 10 * trace.TRACE_TOL
     far = int(np.argmax(np.abs(W[:, :6].imag).sum(1)))
     assert np.abs(W[far, :6].imag).max() > 5  # far out indeed
     lacking = trace.trace_test(problem, start, witnesses=(w, ell, np.delete(W, far, 0), S))
-    assert not lacking.passed and lacking.deviation > 100 * trace.TRACE_TOL
+    assert not lacking.passed and lacking.deviation > 10 * trace.TRACE_TOL
 
 
 def test_missing_start_solutions_are_found():
@@ -132,6 +132,9 @@ def test_verdict_is_cached_and_shown(tmp_path, monkeypatch, capsys):
     assert cli(["ik-prepare", str(path), "--trace", "--quiet"]) == 0
     out = capsys.readouterr().out
     assert "start system of 16 complex solutions, certified by the trace test" in out
+    huge = dataclasses.replace(plain, solutions=np.zeros((trace.MAX_SOLUTIONS + 1, 6), complex))
+    with pytest.raises(ValueError, match=r"^trace: the start set has 201 complex solutions"):
+        trace.certify(homotopy.Problem.of(chain), huge)  # refused before any work
     cached = chain.prepare_ik()  # the traced set replaced the plain one in the cache
     assert cached.traced and cached.certified and cached.witnesses > 100
     assert np.array_equal(cached.solutions, plain.solutions)

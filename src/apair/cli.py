@@ -301,7 +301,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--refresh", action="store_true", help="compute it again even if it is cached")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.add_argument("--trace", action="store_true",
-                   help="also certify the set by the trace test (minutes for hundreds of solutions; cached)")
+                   help="also certify the set by the trace test (seconds for up to 48 solutions, minutes and "
+                   "possibly no verdict for more, refused above 200; cached)")
     p.set_defaults(func=_cmd_ik_prepare)
     p = sub.add_parser("limits", help="joint ranges of a chain file: explicit, or the pairs' collision limits")
     p.add_argument("file", help="a chain TOML file")

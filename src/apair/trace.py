@@ -39,14 +39,17 @@ import numpy as np
 from . import homotopy
 
 DIGITS = 50  # of the refinement of far-out endpoints and of the traces
-TRACE_TOL = 1e-9  # complete sets measured 1e-14 to 1e-11 after refinement; one missing point 1e-7 and up
+TRACE_TOL = 1e-10  # complete sets measured 1e-14 to 1e-12 after refinement; one far-out witness missing 5e-9
 REFINE_AT = 1e-13  # endpoints whose double-precision Newton step stays above this (relative) are refined
 LOOP_SCALE = 5.0  # size of the monodromy loops' random hyperplanes relative to ℓ (small loops hardly permute)
 QUIET = 60  # loops in a row without a new witness that end the monodromy
 MAX_LOOPS = 3000
 ROUNDS = 4  # trace tests at most (trace_test)
+MAX_SOLUTIONS = 200  # start sets that certify() takes on: 48 take seconds, 96 and 128 did not pass in minutes
 T_LOOP_EVERY = 4  # every so many monodromy loops go through the trace family (the others through ℓ)
-T_SCALE = 5.0  # |t1|, |t2|: large enough that every point moves off its start
+T_SCALE = 2.0  # |t1|, |t2|: a missing point moves enough to show, and few paths go far enough to fail
+T_TRIES = 4  # pairs t1, t2 tried for paths that all end (_deviation)
+T_LOOP_SCALE = 5.0  # |t| of the monodromy loops through the trace family (before the random factor)
 
 
 def coordinates(problem: homotopy.Problem, theta: np.ndarray):
@@ -144,9 +147,12 @@ def witness_points(problem: homotopy.Problem, start: homotopy.StartSystem, rng, 
         points = list(W)
     else:
         w, S = homotopy.random_pose(rng), start.solutions
+        # from a start solution near the real ones: ℓ is scaled through its image, and ℓ with small
+        # coefficients would put the witnesses far out in the complex, where paths fail
+        near = np.argsort(np.abs(S.imag).max(axis=1))[:max(4, len(S) // 8)]
         for _ in range(20):
             lam = complex(_crandn(rng, 1)[0])
-            j = int(rng.integers(start.count))
+            j = int(rng.choice(near))
             end, status = homotopy._segment(problem, start.p0, start.p0 + lam * w, S[j:j + 1], rng)
             if status[0] == homotopy.OK:
                 break
@@ -173,7 +179,7 @@ def witness_points(problem: homotopy.Problem, start: homotopy.StartSystem, rng, 
             slices = [Slice(problem, start.p0, w, a, b - a, 0, 0, False) for a, b in ((ell, la), (la, lb), (lb, ell))]
         else:
             cur = np.concatenate([np.concatenate([np.array(S), np.zeros((len(S), 1))], axis=1), np.array(points)])
-            ta, tb = r * T_SCALE * _crandn(rng, 2)
+            ta, tb = r * T_LOOP_SCALE * _crandn(rng, 2)
             slices = [Slice(problem, start.p0, w, ell, np.zeros_like(ell), a, b - a, True)
                       for a, b in ((0, ta), (ta, tb), (tb, 0))]
         ok, stalled = np.ones(len(cur), bool), np.zeros(len(cur), bool)
@@ -342,26 +348,54 @@ def trace_test(problem: homotopy.Problem, start: homotopy.StartSystem, seed: int
     return TraceTest(wit[3], len(wit[2]), deviation, bool(deviation <= TRACE_TOL), time.perf_counter() - t0)
 
 
+def _track_distinct(sl: Slice, X0: np.ndarray, rng) -> np.ndarray | None:
+    """X0 tracked by sl to distinct endpoints: paths that fail, and both paths of an endpoint that
+    two reached (one of them jumped), are tracked again with new γ, RETRIES times at most; None
+    if that does not do."""
+    X, status = sl.track(X0, rng)
+    for _ in range(homotopy.RETRIES + 1):
+        if not np.all(_ended(status)):
+            return None
+        index, owner, again = homotopy._Index(sl.problem), {}, set()
+        for i, x in enumerate(X):
+            new, row = index.place(x[:6])
+            if new:
+                owner[row] = i
+            else:
+                again |= {i, owner[row]}
+        if not again:
+            return X
+        redo = np.array(sorted(again))
+        X[redo], status[redo] = sl.track(X0[redo], rng)
+    return None
+
+
 def _deviation(problem: homotopy.Problem, p0: np.ndarray, witnesses, rng) -> float:
     """How far the traces at f = 0, −t1, −t2 are from a line, relative to the coordinates' sizes
-    (inf where a path was lost or jumped: no verdict)."""
+    (inf where no verdict could be had: a path that was lost, or paths that keep meeting, for
+    T_TRIES pairs t1, t2; far out in the complex a path can fail for one t and not for another)."""
     w, ell, W, S = witnesses
     X0 = np.concatenate([np.concatenate([S, np.zeros((len(S), 1))], axis=1), W]).astype(complex)
-    ts = T_SCALE * _crandn(rng, 2)
-    traces, sizes = [], []
-    for t in (0.0, *ts):
-        sl = Slice(problem, p0, w, ell, np.zeros_like(ell), 0, complex(t), True)
-        X = X0
-        if t != 0:
-            X, status = sl.track(X0, rng)
-            index = homotopy._Index(problem)
-            if not np.all(_ended(status)) or not all(index.add(x[:6]) for x in X):
-                return math.inf  # a lost or a jumped path
-        points = _refine(sl, X)
-        if any(x is None for x in points):
-            return math.inf
-        traces.append(_trace_sum(problem, points))
-        sizes.append(_sizes(problem, X))
+    base = Slice(problem, p0, w, ell, np.zeros_like(ell), 0, 0, True)
+    points = _refine(base, X0)
+    if any(x is None for x in points):
+        return math.inf
+    traces, sizes = [_trace_sum(problem, points)], [_sizes(problem, X0)]
+    for _ in range(T_TRIES):
+        ts = T_SCALE * _crandn(rng, 2)
+        for t in ts:
+            sl = dataclasses.replace(base, dt=complex(t))
+            X = _track_distinct(sl, X0, rng)
+            points = None if X is None else _refine(sl, X)
+            if points is None or any(x is None for x in points):
+                break
+            traces.append(_trace_sum(problem, points))
+            sizes.append(_sizes(problem, X))
+        else:
+            break
+        del traces[1:], sizes[1:]
+    else:
+        return math.inf
     scale = np.max(sizes, axis=0)
     with flint.ctx.workdps(DIGITS):
         r = _acb(ts[1] / ts[0])
@@ -372,6 +406,9 @@ def _deviation(problem: homotopy.Problem, p0: np.ndarray, witnesses, rng) -> flo
 def certify(problem: homotopy.Problem, start: homotopy.StartSystem, progress=None) -> homotopy.StartSystem:
     """The start set with the trace test's verdict (its `certified`, `trace` and `witnesses`), and
     with the solutions the test's monodromy added (then `runs` gets the larger count too)."""
+    if start.count > MAX_SOLUTIONS:
+        raise ValueError(f"trace: the start set has {start.count} complex solutions; the trace test is limited to "
+                         f"{MAX_SOLUTIONS} (its witnesses number about ten times as many, far out in the complex)")
     result = trace_test(problem, start, progress=progress)
     runs = start.runs + ([len(result.solutions)] if len(result.solutions) > start.count else [])
     return dataclasses.replace(start, solutions=result.solutions, runs=runs, certified=result.passed,
