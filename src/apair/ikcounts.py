@@ -128,7 +128,7 @@ def main(argv=None) -> int:
     rows = []
     for p in patterns(args.max_n):
         if p in old and old[p]["start_count"] > args.trace:
-            rows.append(old[p])
+            rows.append({**old[p], "traced": old[p].get("traced", False)})
             continue
         r = count(p, trace_upto=args.trace)
         rows.append(r)
