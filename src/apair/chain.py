@@ -370,8 +370,9 @@ class AChain:
     def prepare_ik(self, progress=None, refresh: bool = False, trace: bool = False):
         """n = 5, 6: the design's homotopy start system (every complex solution at a generic complex
         pose, by monodromy), from the cache or computed now and cached (`apair ik-prepare`).
-        trace: also run the trace test (apair.trace; minutes for hundreds of solutions), whose
-        verdict is cached with the set and becomes its `certified`.
+        trace: also run the trace test (apair.trace: seconds up to 48 solutions, minutes and maybe
+        no verdict for more, refused above 200), whose verdict is cached with the set and becomes
+        its `certified`.
         Returns `apair.homotopy.StartSystem` (.count, .certified, .runs, .loops, .seconds, .trace)."""
         from . import homotopy
 
