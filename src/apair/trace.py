@@ -37,6 +37,7 @@ import flint
 import numpy as np
 
 from . import homotopy
+from .study import _qmul
 
 DIGITS = 50  # of the refinement of far-out endpoints and of the traces
 TRACE_TOL = 1e-10  # complete sets measured 1e-14 to 1e-12 after refinement; one far-out witness missing 5e-9
@@ -129,6 +130,11 @@ def _ended(status: np.ndarray) -> np.ndarray:
     return (status == homotopy.OK) | (status == homotopy.SINGULAR)
 
 
+def _points(S: np.ndarray, W: np.ndarray) -> np.ndarray:
+    """The start solutions S (m, 6) at λ = 0 and the witnesses W (k, 7) as one array (m + k, 7)."""
+    return np.concatenate([np.concatenate([S, np.zeros((len(S), 1))], axis=1), W]).astype(complex)
+
+
 def _crandn(rng, *shape) -> np.ndarray:
     return (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)) / math.sqrt(2)
 
@@ -178,7 +184,7 @@ def witness_points(problem: homotopy.Problem, start: homotopy.StartSystem, rng, 
             la, lb = (ell + r * size * _crandn(rng, 2, 6) for _ in range(2))
             slices = [Slice(problem, start.p0, w, a, b - a, 0, 0, False) for a, b in ((ell, la), (la, lb), (lb, ell))]
         else:
-            cur = np.concatenate([np.concatenate([np.array(S), np.zeros((len(S), 1))], axis=1), np.array(points)])
+            cur = _points(np.array(S), np.array(points))
             ta, tb = r * T_LOOP_SCALE * _crandn(rng, 2)
             slices = [Slice(problem, start.p0, w, ell, np.zeros_like(ell), a, b - a, True)
                       for a, b in ((0, ta), (ta, tb), (tb, 0))]
@@ -217,11 +223,9 @@ def _acb(z) -> flint.acb:
     return flint.acb(z.real, z.imag)
 
 
-def _quat(a, b):
-    return (a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
-            a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
-            a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
-            a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0])
+def _quat(a, b) -> np.ndarray:
+    """Hamilton product of two quaternions of flint.acb (apair.study's, over object arrays)."""
+    return _qmul(np.array(a, dtype=object), np.array(b, dtype=object))
 
 
 def exact_system(problem: homotopy.Problem, theta, P) -> list:
@@ -375,7 +379,7 @@ def _deviation(problem: homotopy.Problem, p0: np.ndarray, witnesses, rng) -> flo
     (inf where no verdict could be had: a path that was lost, or paths that keep meeting, for
     T_TRIES pairs t1, t2; far out in the complex a path can fail for one t and not for another)."""
     w, ell, W, S = witnesses
-    X0 = np.concatenate([np.concatenate([S, np.zeros((len(S), 1))], axis=1), W]).astype(complex)
+    X0 = _points(S, W)
     base = Slice(problem, p0, w, ell, np.zeros_like(ell), 0, 0, True)
     points = _refine(base, X0)
     if any(x is None for x in points):
