@@ -52,6 +52,7 @@ class Signature:
     source: str
     inputs: list[Arg]
     outputs: list[Arg]
+    wide: bool = False  # also emitted in extended precision (KernelSpec.wide)
 
 
 @dataclass
@@ -223,7 +224,7 @@ def lower(spec: KernelSpec) -> Lowered:
                          [(_bare(a), [p.doprint(e) for e in es]) for a, es in outs])
             for target, p in PRINTERS.items()}
     signature = Signature(spec.name, spec.doc, spec.source, [_bare(a) for a in spec.inputs],
-                          [_bare(a) for a in spec.outputs])
+                          [_bare(a) for a in spec.outputs], spec.wide)
     calls = [LoweredCall(c.kernel.name, [(name, _bare(a)) for name, a in zip(c.args, c.kernel.inputs)],
                          _bare(c.kernel.outputs[0]), [(i, str(r)) for i, r in enumerate(c.results) if r in used])
              for c in spec.calls]
@@ -234,6 +235,9 @@ def lower(spec: KernelSpec) -> Lowered:
             if a.design and name is None:
                 raise ValueError(f"{spec.name}: {c.kernel.name}'s design input {a.name} cannot be zeros")
     hoisted = _hoist(spec, local, assignments, reduced, printed["c"])
+    if spec.wide and (spec.calls or hoisted is None):
+        raise ValueError(f"{spec.name}: a wide kernel needs a design-only part and calls no other kernel "
+                         "(the template emits its wide version from the hoisted core)")
     js = None
     if spec.name in WEB_KERNELS:
         if spec.calls:
@@ -314,11 +318,13 @@ class Emitter:
         for name in called:
             if by_name[name].hoisted is None:
                 raise ValueError(f"{name} is called by another kernel but has no design-only part to share")
+        wide = [k for k in all_kernels if k.spec.wide]
+        internal = sorted(set(called) | {k.name for k in wide})
         internal_t, internal_src = self._template("apair_internal.h.j2")
         files["c/apair_internal.h"] = internal_t.render(
-            kernels=[by_name[c] for c in called], prefix=PREFIX,
-            sources=sorted({by_name[c].spec.source for c in called}) or ["no derivation (no kernel calls another)"],
-            hash=content_hash([internal_src] + [fingerprints[c] for c in called]))
+            kernels=[by_name[c] for c in called], wide=wide, prefix=PREFIX,
+            sources=sorted({by_name[c].spec.source for c in internal}) or ["no derivation (no internal kernel)"],
+            hash=content_hash([internal_src] + [fingerprints[c] for c in internal]))
         for k in all_kernels:
             c_hash = content_hash([src_src, fingerprints[k.name]] + [fingerprints[c.kernel] for c in k.calls])
             files[f"c/{k.name}.c"] = src_t.render(kernels=[k], source=k.spec.source, hash=c_hash, prefix=PREFIX,

@@ -179,6 +179,23 @@ def _vec_conj_times(q, x: Quaternion) -> list[sp.Expr]:
     return (Quaternion(*q).conj() * x).vec()
 
 
+def _rotation(J: list[dict], rec: _Recorder) -> Quaternion:
+    """The end frame's rotation quaternion, one joint at a time:
+    x_i = x_{i-1} ⊗ Rz((θ_i + φ_i)/2) ⊗ Rx(α_i/2), each x_i named."""
+    x = Quaternion(sp.S(1), sp.S(0), sp.S(0), sp.S(0))
+    for i, j in enumerate(J, start=1):
+        c, s_ = (rec.name(f"H{i}_{k}", e) for k, e in enumerate(dh_study_half(j)))
+        ca, sa = sp.cos(j["alpha"] / 2), sp.sin(j["alpha"] / 2)
+        x = x * Quaternion(c, sp.S(0), sp.S(0), s_) * Quaternion(ca, sa, sp.S(0), sp.S(0))
+        x = Quaternion(*[rec.name(f"X{i}_{k}", sp.expand(e)) for k, e in enumerate(x.as_list())])
+    return x
+
+
+def _residual(T: sp.Matrix, x: Quaternion, tsyms) -> list[sp.Expr]:
+    """F = [o − t ; vec(q̄ ⊗ x)] for the end frame T, its quaternion x and the pose (t, q)."""
+    return [T[k, 3] - tsyms[k] for k in range(3)] + [sp.expand(e) for e in _vec_conj_times(tsyms[3:], x)]
+
+
 def system_spec(n: int) -> KernelSpec:
     """ik_system{n}: F, ∂F/∂θ and the derivative along a direction of poses (module docstring)."""
     labels = [f"{f}_{i}" for i in range(1, n + 1) for f in LAW_FIELDS]
@@ -201,13 +218,7 @@ def system_spec(n: int) -> KernelSpec:
     F = frames(n, J, rec)
     Jm = screw_jacobian(F, J)
     T = F[n]
-    # the rotation quaternion, one joint at a time: x_i = x_{i-1} ⊗ Rz((θ_i + φ_i)/2) ⊗ Rx(α_i/2)
-    x = Quaternion(sp.S(1), sp.S(0), sp.S(0), sp.S(0))
-    for i, j in enumerate(J, start=1):
-        c, s_ = (rec.name(f"H{i}_{k}", e) for k, e in enumerate(dh_study_half(j)))
-        ca, sa = sp.cos(j["alpha"] / 2), sp.sin(j["alpha"] / 2)
-        x = x * Quaternion(c, sp.S(0), sp.S(0), s_) * Quaternion(ca, sa, sp.S(0), sp.S(0))
-        x = Quaternion(*[rec.name(f"X{i}_{k}", sp.expand(e)) for k, e in enumerate(x.as_list())])
+    x = _rotation(J, rec)
     q, dq = tsyms[3:], dsyms[3:]
     # G[c] = ½ vec(q̄ ⊗ e_c ⊗ x): the rotation residual's derivative along axis c
     G = []
@@ -216,7 +227,7 @@ def system_spec(n: int) -> KernelSpec:
         e[c] = 1
         G.append([rec.name(f"G{c}_{r}", sp.expand(v / 2)) for r, v in
                   enumerate((Quaternion(*q).conj() * Quaternion.pure(e) * x).vec())])
-    F_out = [T[k, 3] - tsyms[k] for k in range(3)] + [sp.expand(e) for e in _vec_conj_times(q, x)]
+    F_out = _residual(T, x, tsyms)
     J_out = []
     for r in range(6):
         for i in range(n):
@@ -233,6 +244,45 @@ def system_spec(n: int) -> KernelSpec:
         outputs=[_complex_out("F", (6,), "residual", outs[:nF]),
                  _complex_out("dF", (6, n), "derivative in the joint angles, row-major", outs[nF:nF + nJ]),
                  _complex_out("dFs", (6,), "derivative along the direction", outs[nF + nJ:])],
+    )
+
+
+def residual_spec(n: int) -> KernelSpec:
+    """ik_residual{n}: F of ik_system{n} alone, from z_i = exp(iθ_i/2) and the amplitudes h_i
+    (the sinusoidal law; h = 0 is an R-pair's), also emitted in extended precision (`wide`).
+
+    Far out in the complex (|Im θ| ≈ 10) the terms of F that cancel are exp(2|Im θ|) larger than
+    F: in double precision Newton's method stalls at about 1e-5. The tracker's corrector takes F
+    from the wide version there and the Jacobian from ik_system6 (a Jacobian with a relative error
+    far below 1 still converges), so that such paths are tracked and their endpoints refined."""
+    zr, law_r = law_in_variable("revolute")
+    zs, law_s = law_in_variable("sinusoidal")
+    assert all(sp.expand(a - b.subs({h: 0, zs: zr})) == 0 for a, b in zip(law_r, law_s)), \
+        "an R-pair's law is the sinusoidal law with h = 0"
+    v_arg, parts, vsyms = _complex_arg("v", (n,), "per joint exp(i theta_i/2)", [f"v_{i}" for i in range(1, n + 1)])
+    hs = tuple(sp.Symbol(f"h_{i}", real=True) for i in range(1, n + 1))
+    h_arg = Arg("h", (n,), "per joint the amplitude h_i of a sinusoidal A-pair, 0 for an R-pair [m]", hs, design=True)
+    tgt_arg, tparts, tsyms = _complex_arg("target", (7,), "pose (t [m], q): translation and rotation quaternion "
+                                          "up to scale", ["t1", "t2", "t3", "q0", "q1", "q2", "q3"])
+    parts.update(tparts)
+    rec = _Recorder()
+    J = []
+    for i in range(1, n + 1):
+        j = joint_symbols(i)
+        sub = {zs: vsyms[i - 1], h: hs[i - 1]}
+        for f, e in zip(("ch", "sh", "d"), law_s):
+            j[f] = rec.name(f"L{i}_{f}", sp.expand(e.xreplace(sub)))
+        J.append(j)
+    dh_arg = Arg("dh", (n, 4), "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])",
+                 tuple(j[k] for j in J for k in ("a", "alpha", "c", "phi")), design=True)
+    T = frames(n, J, rec)[n]
+    steps, outs = split_complex(rec.steps, _residual(T, _rotation(J, rec), tsyms), parts)
+    return KernelSpec(
+        name=f"ik_residual{n}",
+        doc=(f"The residual F of ik_system{n} at z_i = exp(i theta_i/2) (the laws included), also in extended "
+             "precision for the tracker's corrector far out in the complex."),
+        source=SOURCE, inputs=[v_arg, h_arg, tgt_arg, dh_arg], steps=steps,
+        outputs=[_complex_out("F", (6,), "residual", outs)], wide=True,
     )
 
 
@@ -283,6 +333,49 @@ def _mp_system(angles, hs, dh, target, x_sign=None):
     return [T[k, 3] - target[k] for k in range(3)] + vec, x
 
 
+def _evaluate(spec: KernelSpec, values: dict, dh, digits: int):
+    """A complex-valued kernel spec at mpmath inputs (values: {input name: complex values, or for
+    the real input h real values}, dh rows): its outputs as complex numbers, and the quaternion x
+    of the end frame (steps X{n}_k) it computed."""
+    env = {}
+    for a in spec.inputs:
+        if a.name == "dh":
+            env.update({s: sp.Float(x, digits) for s, x in zip(a.symbols, [x for row in dh for x in row])})
+        elif a.name == "h":
+            env.update({s: sp.Float(mpmath.re(x), digits) for s, x in zip(a.symbols, values[a.name])})
+        else:
+            for k, z in enumerate(values[a.name]):
+                env[a.symbols[2 * k]] = sp.Float(z.real, digits)
+                env[a.symbols[2 * k + 1]] = sp.Float(z.imag, digits)
+    for s, e in spec.steps:
+        env[s] = sp.N(e.xreplace(env), digits)
+    flat = [mpmath.mpmathify(sp.N(e.xreplace(env), digits)) for a in spec.outputs for e in a.exprs]
+    n = spec.inputs[-1].shape[0]
+    # the kernel's quaternion sign: the half-angle product's (the matrix route's is aligned with it)
+    x = [mpmath.mpmathify(sp.N(sp.Symbol(f"X{n}_{k}_re", real=True).xreplace(env), digits))
+         + 1j * mpmath.mpmathify(sp.N(sp.Symbol(f"X{n}_{k}_im", real=True).xreplace(env), digits)) for k in range(4)]
+    return [flat[2 * k] + 1j * flat[2 * k + 1] for k in range(len(flat) // 2)], x
+
+
+def check_residual(n: int = 3, digits: int = 30) -> float:
+    """Max difference between ik_residual{n} and the independent route (the 4×4 DH product) at
+    a random complex point with the joints alternately A- and R-pairs."""
+    spec = residual_spec(n)
+    rng = random.Random(200 + n)
+    with mpmath.workdps(digits):
+        th = [mpmath.mpc(rng.uniform(-3, 3), rng.uniform(-2, 2)) for _ in range(n)]
+        hs = [rng.uniform(0.2, 1.0) if i % 2 == 0 else 0.0 for i in range(n)]
+        dh = [[mpmath.mpf(rng.uniform(-1, 1)), mpmath.mpf(rng.uniform(-2, 2)), mpmath.mpf(rng.uniform(-1, 1)),
+               mpmath.mpf(rng.uniform(-2, 2))] for _ in range(n)]
+        target = [mpmath.mpc(rng.uniform(-1, 1), rng.uniform(-1, 1)) for _ in range(7)]
+        got, x_kernel = _evaluate(spec, {"v": [mpmath.exp(1j * t / 2) for t in th], "h": hs, "target": target},
+                                  dh, digits)
+        F, _ = _mp_system(th, hs, dh, target, x_kernel)
+        worst = max(abs(g - f) for g, f in zip(got, F))
+    assert worst < 1e-15, f"ik_residual{n} differs from the DH route by {worst}"
+    return float(worst)
+
+
 def check_system(n: int = 3, digits: int = 30) -> float:
     """Max difference between the kernel's expressions and the independent route at a random
     complex point: F, dF/dθ (central differences of the DH product) and dFs (F is linear in the
@@ -301,23 +394,7 @@ def check_system(n: int = 3, digits: int = 30) -> float:
         target, direction = [cplx() for _ in range(7)], [cplx() for _ in range(7)]
         law = [x for t, hh in zip(th, hs) for x in (mpmath.cos(t / 2), mpmath.sin(t / 2), hh * mpmath.cos(t / 2),
                                                       -hh / 2 * mpmath.sin(t / 2))]
-        values = {"law": law, "target": target, "direction": direction}
-        env = {}
-        for a in spec.inputs:
-            if a.name == "dh":
-                env.update({s: sp.Float(x, digits) for s, x in zip(a.symbols, [x for row in dh for x in row])})
-            else:
-                for k, z in enumerate(values[a.name]):
-                    env[a.symbols[2 * k]] = sp.Float(z.real, digits)
-                    env[a.symbols[2 * k + 1]] = sp.Float(z.imag, digits)
-        for s, e in spec.steps:
-            env[s] = sp.N(e.xreplace(env), digits)
-        flat = [mpmath.mpmathify(sp.N(e.xreplace(env), digits)) for a in spec.outputs for e in a.exprs]
-        got = [flat[2 * k] + 1j * flat[2 * k + 1] for k in range(len(flat) // 2)]
-        # the kernel's quaternion sign: the half-angle product's; align the matrix route's with it
-        x_kernel = [mpmath.mpmathify(sp.N(sp.Symbol(f"X{n}_{k}_re", real=True).xreplace(env), digits))
-                    + 1j * mpmath.mpmathify(sp.N(sp.Symbol(f"X{n}_{k}_im", real=True).xreplace(env), digits))
-                    for k in range(4)]
+        got, x_kernel = _evaluate(spec, {"law": law, "target": target, "direction": direction}, dh, digits)
         F, x = _mp_system(th, hs, dh, target, x_kernel)
         worst = max(abs(a - b) for a, b in zip(x, x_kernel))
         worst = max([worst] + [abs(g - f) for g, f in zip(got[:6], F)])
@@ -336,8 +413,9 @@ def check_system(n: int = 3, digits: int = 30) -> float:
 
 
 def derive():
-    """The law kernels at exp(iθ/2) and ik_system6 (a shorter chain is tracked with
-    virtual joints added, see apair.homotopy), after the independent check on n = 1 and 3."""
+    """The law kernels at exp(iθ/2), ik_system6 and ik_residual6 (a shorter chain is tracked with
+    virtual joints added, see apair.homotopy), after the independent checks on n = 1 and 3."""
     checks = {n: check_system(n) for n in (1, 3)}
-    specs = [law_spec("revolute"), law_spec("sinusoidal"), system_spec(MAX_N)]
+    checks.update({f"residual{n}": check_residual(n) for n in (1, 3)})
+    specs = [law_spec("revolute"), law_spec("sinusoidal"), system_spec(MAX_N), residual_spec(MAX_N)]
     return [], specs, {"system_check": checks}

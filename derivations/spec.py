@@ -65,6 +65,7 @@ class KernelSpec:
     outputs: list[Arg]
     steps: list[tuple[sp.Symbol, sp.Expr]] = field(default_factory=list)
     calls: list[Call] = field(default_factory=list)
+    wide: bool = False  # also emitted in extended precision (C, apair_wide): see codegen/templates/kernels.c.j2
 
     def __post_init__(self):
         for a in self.inputs:
@@ -138,6 +139,8 @@ class KernelSpec:
         """Content hash of the spec: names, shapes, symbols and expressions (srepr is canonical)."""
         h = hashlib.sha256()
         h.update(self.name.encode())
+        if self.wide:
+            h.update(b"wide")
         for c in self.calls:
             h.update(f"call {c.kernel.fingerprint()} {c.args} {[str(r) for r in c.results]}".encode())
         for a in self.inputs:

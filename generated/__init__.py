@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: e62a36bd01c09138
+Content hash: 6ac56c393ad3dbf6
 """

@@ -449,8 +449,8 @@ def test_ik4_kernels_under_sanitizers(tmp_path):
     prog = tmp_path / "ik4.c"
     prog.write_text(src)
     exe = tmp_path / "ik4"
-    run(["gcc", "-std=c99", *STRICT, "-O1", *SANITIZE, f"-I{CDIR}", str(prog), str(CDIR / "apair_ik.c"), "-lm",
-         "-o", str(exe)])
+    run(["gcc", "-std=c99", *STRICT, "-O1", *SANITIZE, f"-I{CDIR}", str(prog), str(CDIR / "apair_ik.c"),
+         str(CDIR / "ik_residual6.c"), "-lm", "-o", str(exe)])
     res = run([str(exe)], env={**os.environ, **SAN_ENV})
     assert res.stderr == ""
     out = {line.split()[0]: line.split()[1:] for line in res.stdout.splitlines()}

@@ -239,6 +239,37 @@ def test_numpy_tracker_agrees_with_the_c_tracker():
     assert np.all(d < 1e-6) and np.median(d) < 1e-10  # one solution each (the worst conditioned to ~1e-7)
 
 
+def test_far_out_solutions_are_refined_in_extended_precision():
+    """Solutions far out in the complex (|Im θ| > 9) at a generic pose: with the residual in
+    extended precision (ik_residual6_wide) the tracker's Newton refines each to the solution that
+    Newton at 50 digits (apair.trace's independent DH route) confirms, and none is left SINGULAR;
+    with double residuals alone it stalls orders of magnitude farther away."""
+    flint = pytest.importorskip("flint")
+    from apair import trace
+
+    problem = homotopy.Problem.of(ikcounts.design("AARRRR"))
+    p0, sols, _ = homotopy.monodromy(problem, np.random.default_rng(2))
+    far = sols[np.abs(sols.imag).max(axis=1) > 9]
+    assert len(far) >= 5
+
+    def exact(x0):
+        with flint.ctx.workdps(50):
+            P, x = [trace._acb(v) for v in p0], [trace._acb(v) for v in x0]
+            for _ in range(5):
+                G = np.array([complex(v.mid()) for v in trace.exact_system(problem, x, P)])
+                _, J, _ = homotopy.system(problem, np.array([complex(v.mid()) for v in x]), p0, np.zeros(7, complex))
+                x = [(xi + trace._acb(di)).mid() for xi, di in zip(x, np.linalg.solve(J, -G))]
+            return np.array([complex(v.mid()) for v in x])
+
+    worst = {}
+    for wide in ((4.0, 4.0), (np.inf, np.inf)):
+        end, status, _, _ = homotopy.track(problem, p0, p0, 1.0, far, wide=wide)
+        worst[wide] = max(np.abs(e - exact(e)).max() for e in end)
+        if wide[0] < np.inf:
+            assert np.all(status == homotopy.OK), status
+    assert worst[(4.0, 4.0)] < 1e-10 and worst[(np.inf, np.inf)] > 100 * worst[(4.0, 4.0)], worst
+
+
 def test_threads_track_the_same_paths(monkeypatch):
     """The paths shared among threads end where one thread takes them (bit for bit: each path is
     tracked on its own), and a bad APAIR_THREADS is refused."""

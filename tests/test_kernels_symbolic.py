@@ -31,7 +31,7 @@ def random_inputs(spec, rng: np.random.Generator, count: int) -> list[np.ndarray
     if spec.name.startswith("ik_"):  # the homotopy's kernels at a complex angle θ, |Im θ| <= 1
         dims = (count,) + spec.inputs[0].shape[:-2 if spec.name.startswith("ik_system") else -1]
         theta = rng.uniform(-np.pi, np.pi, dims) + 1j * rng.uniform(-1, 1, dims)
-        if spec.name.startswith("ik_law"):
+        if spec.name.startswith(("ik_law", "ik_residual")):  # they take v = exp(iθ/2)
             v = np.exp(0.5j * theta)
             out[0] = np.stack([v.real, v.imag], -1)
         else:

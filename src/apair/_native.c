@@ -639,15 +639,18 @@ static PyObject *track_result(int rc, PyArrayObject **out, const char *what)
     return Py_BuildValue("NNNN", out[0], out[1], out[2], out[3]);
 }
 
-/* ik_track(kind, pair, dh, p0, p1, gamma, start) -> (end, status, steps, cond) */
+/* ik_track(kind, pair, dh, p0, p1, gamma, start[, wide_track, wide_end]) -> (end, status, steps, cond) */
 static PyObject *native_ik_track(PyObject *self, PyObject *args)
 {
     PyObject *o[9];
     PyArrayObject *a[9] = {NULL};
     PyObject *result = NULL;
     Py_complex gamma;
+    apair_ik_options opt;
+    apair_ik_default_options(&opt);
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOODO", &o[0], &o[1], &o[2], &o[5], &o[6], &gamma, &o[8])) {
+    if (!PyArg_ParseTuple(args, "OOOOODO|dd", &o[0], &o[1], &o[2], &o[5], &o[6], &gamma, &o[8], &opt.wide_track,
+                          &opt.wide_end)) {
         return NULL;
     }
     npy_intp nk[1] = {-1};
@@ -667,8 +670,6 @@ static PyObject *native_ik_track(PyObject *self, PyObject *args)
     PyArrayObject *out[4];
     if (track_outputs(s_out, out)) goto done;
     apair_ik_problem pb = {(int)n, (const int *)PyArray_DATA(a[0]), PyArray_DATA(a[1]), PyArray_DATA(a[2])};
-    apair_ik_options opt;
-    apair_ik_default_options(&opt);
     double g[2] = {gamma.real, gamma.imag};
     int rc;
     Py_BEGIN_ALLOW_THREADS

@@ -21,6 +21,12 @@ reaches all of it:
   the C kernels. Paths that fail, or land on the same endpoint as another (a path jump), are
   tracked again with a new γ. Real endpoints are the candidates; `apair.ik` verifies them with
   the fk kernel.
+- **Far out** in the complex (|Im θ| ≈ 10) the terms of F that cancel are exp(2|Im θ|) larger
+  than F and Newton in double stalls (at about 1e-5). The C tracker then takes F from
+  ik_residual6 in extended precision (`wide`: beyond which |Im θ| a stalled Newton step does so,
+  while tracking and at the endpoint): WIDE_START for the start sets (their far-out endpoints are
+  refined, and a regular one is OK), WIDE_POSE per pose (endpoints far out are not real, so they
+  are not refined). The NumPy fallback has double only.
 - **Completeness**: a start set is `certified` by its trace test (apair.trace, passed to
   `start_system` as `certify`) where one has run. Otherwise it is `certified` when two
   independent monodromy runs (each from its own random start, each stable for STABLE loops) found
@@ -53,6 +59,8 @@ SAME = 1e-4  # two endpoints whose angles differ by less than this are one solut
 VIRTUAL_ZERO = 1e-6  # |exp(iθ) − 1| under which a virtual joint is at 0
 REAL = 1e-5  # |Im θ| under which an endpoint is a real candidate (fk verifies it)
 OK, SINGULAR, FAILED, DIVERGED, TOO_LONG = range(5)
+WIDE_START = (4.0, 4.0)  # |Im θ| beyond which a stalled Newton step goes to extended precision: (tracking, endpoint)
+WIDE_POSE = (4.0, math.inf)
 
 
 # ----------------------------------------------------------------------------- the problem
@@ -291,18 +299,21 @@ def _unit_gamma(rng: np.random.Generator) -> complex:
     return complex(np.exp(1j * rng.uniform(-1.2, 1.2)))
 
 
-def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None = None):
+def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None = None, wide=None):
     """Every row of start (k, n) from p0 to p1: (end, status, steps, cond). engine: "c" (the
-    generated tracker apair_ik_track), "numpy" (track_numpy), or None: C where it is installed."""
+    generated tracker apair_ik_track), "numpy" (track_numpy), or None: C where it is installed.
+    wide: (track, end), the |Im θ| beyond which the C tracker's Newton steps that stall take the
+    residual in extended precision (WIDE_START by default)."""
     start = np.ascontiguousarray(start, complex).reshape(-1, problem.n)
     native = _native() if engine in (None, "c") else None
     if native is None:
         if engine == "c":
             raise RuntimeError("engine: the compiled C kernels are not installed")
         return track_numpy(problem, p0, p1, gamma, start)
+    wide = WIDE_START if wide is None else wide
     args = (problem.kind, problem.pair, problem.dh, np.ascontiguousarray(p0, complex),
             np.ascontiguousarray(p1, complex), complex(gamma))
-    return threaded(lambda share: native.ik_track(*args, share), start)
+    return threaded(lambda share: native.ik_track(*args, share, *wide), start)
 
 
 def threaded(track_share, start: np.ndarray):
@@ -678,7 +689,7 @@ def solve(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 0) ->
     todo = np.arange(start.count)
     diverged = np.zeros(start.count, bool)
     for _ in range(RETRIES + 1):
-        e, s, _, _ = track(problem, start.p0, p1, _unit_gamma(rng), start.solutions[todo])
+        e, s, _, _ = track(problem, start.p0, p1, _unit_gamma(rng), start.solutions[todo], wide=WIDE_POSE)
         again = {}
         for j, endpoint, st in zip(todo, canonical(problem, e), s):
             diverged[j] = st == DIVERGED
