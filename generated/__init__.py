@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 6ac56c393ad3dbf6
+Content hash: 3ddd53ef58df1483
 """

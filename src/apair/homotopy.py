@@ -299,18 +299,17 @@ def _unit_gamma(rng: np.random.Generator) -> complex:
     return complex(np.exp(1j * rng.uniform(-1.2, 1.2)))
 
 
-def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None = None, wide=None):
+def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None = None, wide=WIDE_START):
     """Every row of start (k, n) from p0 to p1: (end, status, steps, cond). engine: "c" (the
     generated tracker apair_ik_track), "numpy" (track_numpy), or None: C where it is installed.
     wide: (track, end), the |Im θ| beyond which the C tracker's Newton steps that stall take the
-    residual in extended precision (WIDE_START by default)."""
+    residual in extended precision."""
     start = np.ascontiguousarray(start, complex).reshape(-1, problem.n)
     native = _native() if engine in (None, "c") else None
     if native is None:
         if engine == "c":
             raise RuntimeError("engine: the compiled C kernels are not installed")
         return track_numpy(problem, p0, p1, gamma, start)
-    wide = WIDE_START if wide is None else wide
     args = (problem.kind, problem.pair, problem.dh, np.ascontiguousarray(p0, complex),
             np.ascontiguousarray(p1, complex), complex(gamma))
     return threaded(lambda share: native.ik_track(*args, share, *wide), start)
