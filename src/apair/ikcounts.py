@@ -14,9 +14,9 @@ How each count is certified ("how"): by the trace test (apair.trace) for the sta
 run on (`--trace MAX_COUNT`: sets of up to MAX_COUNT solutions; its monodromy also adds any start
 solution the runs missed), otherwise by two independent monodromy runs that found the same number
 (and for 6R the known 16 of Lee–Liang and Raghavan–Roth; for n ≤ 4 the eliminations of apair.ik
-give an independent count, checked by the tests). Two agreeing runs are weaker: counts just below
-round numbers (248, 319, 511, 639, 1279, 2559) suggest solutions far out in the complex, where
-paths lose digits, that the runs miss alike.
+give an independent count, checked by the tests). Two agreeing runs are weaker: solutions far out
+in the complex, where paths lose digits, can be missed by all runs alike (before the tracker took
+the residual in extended precision there, seven counts were one to eight short of round numbers).
 """
 from __future__ import annotations
 
@@ -111,32 +111,48 @@ def count(pattern: str, seed: int = 0, progress=None, trace_upto: int = 0) -> di
 
 
 def main(argv=None) -> int:
-    """`python -m apair.ikcounts OUT.json [MAX_N] [--trace MAX_COUNT] [--update]`: every pattern's
-    count, one line each as it goes; --trace: the trace test judges start sets of at most MAX_COUNT
-    solutions; --update: only the rows of OUT.json whose start sets it judges are computed again."""
+    """`python -m apair.ikcounts OUT.json [MAX_N] [--trace MAX_COUNT] [--update | --only P,Q,...]`:
+    every pattern's count, one line each as it goes; --trace: the trace test judges start sets of at
+    most MAX_COUNT solutions; --update: only the rows of OUT.json whose start sets it judges are
+    computed again; --only: only the rows of the patterns named (each as stored: the first of it and
+    its reverse)."""
     import argparse
 
     parser = argparse.ArgumentParser(prog="python -m apair.ikcounts")
     parser.add_argument("out", type=Path)
     parser.add_argument("max_n", type=int, nargs="?", default=6)
     parser.add_argument("--trace", type=int, default=0, metavar="MAX_COUNT")
-    parser.add_argument("--update", action="store_true")
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("--update", action="store_true")
+    group.add_argument("--only", type=lambda s: s.upper().split(","), default=None, metavar="P,Q,...")
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    known = patterns(args.max_n)
+    for p in args.only or ():
+        if p not in known:
+            parser.error(f"--only: {p!r} is not a stored pattern of 1 to {args.max_n} joints (A and R, the first "
+                         f"of a pattern and its reverse)")
     old = {}
-    if args.update:
+    if args.update or args.only:
+        if not args.out.is_file():
+            parser.error(f"out: {args.out} does not exist (--update and --only change its rows)")
         old = {r["pattern"]: r for r in json.loads(args.out.read_text())["counts"]}
     rows = []
-    for p in patterns(args.max_n):
-        if p in old and old[p]["start_count"] > args.trace:
+    for p in known:
+        if p in old and (p not in args.only if args.only else old[p]["start_count"] > args.trace):
             rows.append({**old[p], "traced": old[p].get("traced", False)})
             continue
         r = count(p, trace_upto=args.trace)
         rows.append(r)
         print(f"{p:6s} {r['count']:6d}  (start set {r['start_count']}, {r['how']}, {r['seconds']} s)", flush=True)
-        args.out.write_text(json.dumps({"counts": rows + [old[q] for q in patterns(args.max_n)[len(rows):] if q in old]},
-                                       indent=1) + "\n")
-    args.out.write_text(json.dumps({"counts": rows}, indent=1) + "\n")
+        _write(args.out, rows, old)
+    _write(args.out, rows, old)
     return 0
+
+
+def _write(out: Path, rows: list[dict], old: dict) -> None:
+    """The rows computed so far, then the stored rows not reached yet (or beyond MAX_N)."""
+    done = {r["pattern"] for r in rows}
+    out.write_text(json.dumps({"counts": rows + [r for p, r in old.items() if p not in done]}, indent=1) + "\n")
 
 
 def load() -> list[dict]:
