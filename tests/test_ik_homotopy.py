@@ -393,6 +393,54 @@ def test_a_path_that_jumped_is_tracked_again(tracked):
     assert sol.complex_count == 48 and sol.certified
 
 
+def test_missing_solutions_are_found_by_chains_in_one_round(monkeypatch):
+    """Paths that failed and a path that jumped at the first γ: one retry round, chasing from
+    each start whose endpoint is missing to the start whose first-γ endpoint its path reached,
+    finds every missing solution (a new γ permutes start and end solutions, so tracking the
+    failed starts alone finds known ones again)."""
+    problem = homotopy.Problem.of(ikcounts.design("ARRRRR", seed=2))
+    start = homotopy.prepare(problem, seed=0)
+    assert start.count == 48
+    T = ikcounts.design("ARRRRR", seed=2).fk(np.random.default_rng(1).uniform(-1, 1, 6))
+    truth = homotopy.solve(problem, start, T)
+    assert truth.failed == 0 and len(truth.theta) == 48
+    real_track, gammas = homotopy.track, []
+
+    def track(problem, p0, p1, gamma, rows, **kw):
+        e, s, steps, cond = real_track(problem, p0, p1, gamma, rows, **kw)
+        if not gammas:  # the first γ: 6 paths fail, path 7 jumps onto path 8's endpoint
+            s = s.copy()
+            s[:6] = homotopy.FAILED
+            e = e.copy()
+            e[7] = e[8]
+        if gamma not in gammas:
+            gammas.append(gamma)
+        return e, s, steps, cond
+
+    monkeypatch.setattr(homotopy, "track", track)
+    ends = homotopy.solve(problem, start, T)
+    assert len(gammas) == 2  # one retry round
+    assert ends.failed == 0 and ends.complete == start.certified and len(ends.theta) == 48
+    index = homotopy._Index(problem)
+    assert all(index.add(t) for t in truth.theta) and not any(index.add(t) for t in ends.theta)
+
+
+def test_unrefined_endpoints_are_one_solution_within_loose():
+    """Endpoints not refined to full accuracy (far out) differ by up to 1e-3 for one solution:
+    they are merged within LOOSE, refined ones within SAME, and a refined endpoint takes the place
+    of an unrefined one."""
+    problem = homotopy.Problem.of(ikcounts.design("AARRRR"))
+    x = np.array([0.3 + 11j, -1.0, 2.0, 0.5, -0.2, 1.0 + 0.3j])
+    index = homotopy._Index(problem)
+    assert index.place(x, loose=True) == (True, 0)
+    assert index.place(x + 2e-3, loose=True) == (False, 0)
+    assert index.place(x + 2e-3j) == (False, 0) and index.loose == [False]
+    assert np.allclose(index.rows[0], x + 2e-3j)
+    assert index.place(x + 5e-3j) == (True, 1)  # refined ones differ by more than SAME
+    assert index.place(x + 0.05, loose=True)[0]  # distinct beyond LOOSE
+    assert index.place(x + (4 * np.pi + 1e-3), loose=True) == (False, 0)  # the real part modulo 4π
+
+
 def test_tracking_in_a_forked_child(monkeypatch, tracked):
     """A child forked after the parent's tracking threads started makes its own (no hang)."""
     import multiprocessing

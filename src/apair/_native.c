@@ -639,7 +639,7 @@ static PyObject *track_result(int rc, PyArrayObject **out, const char *what)
     return Py_BuildValue("NNNN", out[0], out[1], out[2], out[3]);
 }
 
-/* ik_track(kind, pair, dh, p0, p1, gamma, start[, wide_track, wide_end]) -> (end, status, steps, cond) */
+/* ik_track(kind, pair, dh, p0, p1, gamma, start[, wide_track, wide_end, wide_steps]) -> (end, status, steps, cond) */
 static PyObject *native_ik_track(PyObject *self, PyObject *args)
 {
     PyObject *o[9];
@@ -649,8 +649,8 @@ static PyObject *native_ik_track(PyObject *self, PyObject *args)
     apair_ik_options opt;
     apair_ik_default_options(&opt);
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOODO|dd", &o[0], &o[1], &o[2], &o[5], &o[6], &gamma, &o[8], &opt.wide_track,
-                          &opt.wide_end)) {
+    if (!PyArg_ParseTuple(args, "OOOOODO|ddi", &o[0], &o[1], &o[2], &o[5], &o[6], &gamma, &o[8], &opt.wide_track,
+                          &opt.wide_end, &opt.wide_steps)) {
         return NULL;
     }
     npy_intp nk[1] = {-1};

@@ -18,15 +18,17 @@ reaches all of it:
 - **Per pose**: the start solutions are tracked from p0 to the target with a random γ (path
   p0 + s (p1 − p0), s = γτ/(1 + (γ − 1)τ)), in C (`apair_ik_track`: RK4 predictor, Newton
   corrector, Newton refinement and a condition number at the end), or by `track_numpy` without
-  the C kernels. Paths that fail, or land on the same endpoint as another (a path jump), are
-  tracked again with a new γ. Real endpoints are the candidates; `apair.ik` verifies them with
-  the fk kernel.
+  the C kernels. The solutions that paths which failed, or landed on the same endpoint as another
+  (a path jump), left missing are looked for with new γ (see `solve`). Real endpoints are the
+  candidates; `apair.ik` verifies them with the fk kernel.
 - **Far out** in the complex (|Im θ| ≈ 10) the terms of F that cancel are exp(2|Im θ|) larger
   than F and Newton in double stalls (at about 1e-5). The C tracker then takes F from
   ik_residual6 in extended precision (`wide`: beyond which |Im θ| a stalled Newton step does so,
-  while tracking and at the endpoint): WIDE_START for the start sets (their far-out endpoints are
-  refined, and a regular one is OK), WIDE_POSE per pose (endpoints far out are not real, so they
-  are not refined). The NumPy fallback has double only.
+  while tracking and at the endpoint, and the most steps a path may take so): WIDE_START for the
+  start sets (their far-out endpoints are refined, and a regular one is OK), WIDE_POSE per pose
+  (endpoints far out are not real, so they are not refined, and a path that crawls far out is
+  given up after 100 such steps: with another γ it takes another way). An endpoint left
+  unrefined (SINGULAR) is one with another within LOOSE. The NumPy fallback has double only.
 - **Completeness**: a start set is `certified` by its trace test (apair.trace, passed to
   `start_system` as `certify`) where one has run. Otherwise it is `certified` when two
   independent monodromy runs (each from its own random start, each stable for STABLE loops) found
@@ -54,13 +56,16 @@ FORMAT = 2  # of the cached start systems
 STABLE = 20  # loops in a row without a new solution that end a monodromy run
 MAX_LOOPS = 400
 CHECK_LOOPS = 3  # loops after the runs in which no path may be lost for a certified start set
-RETRIES = 10  # new gammas for the paths that failed or jumped (rare poses need many)
+RETRIES = 10  # new γ for what paths that failed or jumped left undone (per pose: rounds, see solve)
 SAME = 1e-4  # two endpoints whose angles differ by less than this are one solution
+LOOSE = 1e-2  # the same for an endpoint not refined to full accuracy (far out, they are off by up to 1e-3)
 VIRTUAL_ZERO = 1e-6  # |exp(iθ) − 1| under which a virtual joint is at 0
 REAL = 1e-5  # |Im θ| under which an endpoint is a real candidate (fk verifies it)
 OK, SINGULAR, FAILED, DIVERGED, TOO_LONG = range(5)
-WIDE_START = (4.0, 4.0)  # |Im θ| beyond which a stalled Newton step goes to extended precision: (tracking, endpoint)
-WIDE_POSE = (4.0, math.inf)
+# |Im θ| beyond which a stalled Newton step goes to extended precision (tracking, endpoint), and the
+# most tracking steps a path may take in it
+WIDE_START = (4.0, 4.0, 500)
+WIDE_POSE = (4.0, math.inf, 100)
 
 
 # ----------------------------------------------------------------------------- the problem
@@ -258,32 +263,43 @@ def canonical(problem: Problem, theta: np.ndarray) -> np.ndarray:
 class _Index:
     """Solutions (complex angles) with a bucket index on Im θ_1, so that membership tests of
     thousands of them are fast. Two solutions are one when their angles differ by at most SAME in
-    every joint, the real parts modulo the joint's period (one pose: 2π for an R-pair, 4π for an
-    A-pair)."""
+    every joint (LOOSE if either is `loose`, not refined to full accuracy), the real parts modulo
+    the joint's period (one pose: 2π for an R-pair, 4π for an A-pair)."""
 
     def __init__(self, problem: Problem):
         self.problem = problem
         self.period = np.where(problem.kind == 0, 2 * np.pi, 4 * np.pi)
         self.rows: list[np.ndarray] = []
+        self.loose: list[bool] = []
         self.buckets: dict = {}
 
     def add(self, theta) -> bool:
         """Adds θ unless it is already there; whether it was new."""
         return self.place(theta)[0]
 
-    def place(self, theta, is_canonical: bool = False) -> tuple[bool, int]:
+    def _key(self, theta) -> int:
+        return int(math.floor(theta[0].imag / LOOSE))
+
+    def place(self, theta, is_canonical: bool = False, loose: bool = False) -> tuple[bool, int]:
         """Adds θ unless it is already there: (whether it was new, its row). is_canonical: θ is
-        already canonical (a batch canonicalised at once)."""
+        already canonical (a batch canonicalised at once). A refined θ that is a loose row's
+        solution takes that row's place."""
         theta = np.asarray(theta) if is_canonical else canonical(self.problem, np.asarray(theta))
-        key = int(math.floor(theta[0].imag / (100 * SAME)))
+        key = self._key(theta)
         for k in (key - 1, key, key + 1):
             for j in self.buckets.get(k, ()):
                 d = theta - self.rows[j]
                 re = np.abs(d.real) % self.period
-                if np.all(np.maximum(np.minimum(re, self.period - re), np.abs(d.imag)) <= SAME):
+                if np.all(np.maximum(np.minimum(re, self.period - re), np.abs(d.imag))
+                          <= (LOOSE if loose or self.loose[j] else SAME)):
+                    if self.loose[j] and not loose:
+                        self.buckets[k].remove(j)
+                        self.buckets.setdefault(key, []).append(j)
+                        self.rows[j], self.loose[j] = theta, False
                     return False, j
         self.buckets.setdefault(key, []).append(len(self.rows))
         self.rows.append(theta)
+        self.loose.append(loose)
         return True, len(self.rows) - 1
 
 
@@ -302,8 +318,8 @@ def _unit_gamma(rng: np.random.Generator) -> complex:
 def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None = None, wide=WIDE_START):
     """Every row of start (k, n) from p0 to p1: (end, status, steps, cond). engine: "c" (the
     generated tracker apair_ik_track), "numpy" (track_numpy), or None: C where it is installed.
-    wide: (track, end), the |Im θ| beyond which the C tracker's Newton steps that stall take the
-    residual in extended precision."""
+    wide: (track, end, steps), the |Im θ| beyond which the C tracker's Newton steps that stall take
+    the residual in extended precision, and the most tracking steps of a path in it."""
     start = np.ascontiguousarray(start, complex).reshape(-1, problem.n)
     native = _native() if engine in (None, "c") else None
     if native is None:
@@ -669,47 +685,78 @@ class Endpoints:
     paths: int
     failed: int
     diverged: int
-    singular: np.ndarray | None = None  # (k,) bool: the endpoint's Jacobian is singular (not refined)
+    singular: np.ndarray | None = None  # (k,) bool: no path's endpoint there was refined (far out, or singular)
 
 
 def solve(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 0) -> Endpoints:
     """Tracks the start system to the pose T (4 × 4, in the chain's units).
 
-    Every regular endpoint is a solution (Newton converged at it), so the endpoints of all
-    attempts are pooled. The paths that failed are tracked again with a new γ, and so are both
-    paths that ended at one endpoint: either may have jumped, and the one that did has lost its
-    own endpoint. This goes on until as many distinct endpoints (plus paths to infinity) as start
-    solutions are found, or RETRIES attempts are spent."""
+    Every regular endpoint is a solution (Newton converged at it), so the endpoints of all paths
+    are pooled. The first γ takes every path. Where paths failed, or two ended at one endpoint
+    (one of them jumped), as many solutions are missing: the first γ's endpoints of those starts,
+    the set U. Each further round takes a new γ and from every start of U a chain of paths: where
+    a path ends at the first γ's endpoint of another start, that start is tracked next. The two
+    γ permute the solutions differently, and the chain is that permutation's cycle, which leaves
+    the known endpoints only at one of U's: when no path fails, one round reaches all of them.
+    Rounds go on until as many distinct endpoints (plus paths to infinity: the first γ's, and
+    the chains' that end there in a round without failures) as start solutions are found, or
+    RETRIES rounds are spent."""
     rng = np.random.default_rng([seed, 5])
     p1 = problem.target(T)
     found = _Index(problem)
-    owner: dict[int, int] = {}  # endpoint row -> the path that found it first
-    singular: list[bool] = []  # per endpoint row: where its first path ended SINGULAR
-    todo = np.arange(start.count)
-    diverged = np.zeros(start.count, bool)
-    for _ in range(RETRIES + 1):
-        e, s, _, _ = track(problem, start.p0, p1, _unit_gamma(rng), start.solutions[todo], wide=WIDE_POSE)
-        again = {}
-        for j, endpoint, st in zip(todo, canonical(problem, e), s):
-            diverged[j] = st == DIVERGED
-            if st in (OK, SINGULAR):  # SINGULAR: not refined to full accuracy (far out, a multiple root)
-                new, row = found.place(endpoint, is_canonical=True)
-                if new:
-                    owner[row] = int(j)
-                    singular.append(st == SINGULAR)
-                elif st == OK and owner[row] != j:
-                    again[int(j)] = again[owner[row]] = True
-            elif st != DIVERGED:
-                again[int(j)] = True
-        if len(found.rows) + int(diverged.sum()) >= start.count or not again:
+    owner: dict[int, int | None] = {}  # endpoint row -> the start it is the first γ's endpoint of
+    missing: set[int] = set()  # U
+    e, s, _, _ = track(problem, start.p0, p1, _unit_gamma(rng), start.solutions, wide=WIDE_POSE)
+    diverged = int(np.sum(s == DIVERGED))
+    infinite = 0  # chains of a round without failures that end at infinity
+    for j, endpoint, st in zip(range(start.count), canonical(problem, e), s):
+        if st in (OK, SINGULAR):  # SINGULAR: not refined to full accuracy (far out, a multiple root)
+            new, row = found.place(endpoint, is_canonical=True, loose=st == SINGULAR)
+            if new:
+                owner[row] = j
+            elif st == OK and owner[row] is not None:
+                missing |= {j, owner[row]}
+                owner[row] = None
+            elif st == OK:
+                missing.add(j)
+        elif st != DIVERGED:
+            missing.add(j)
+    for _ in range(RETRIES):
+        if len(found.rows) + diverged + infinite >= start.count or not missing:
             break
-        todo = np.array(sorted(again), int)
+        gamma, failed, ends = _unit_gamma(rng), False, 0
+        tracked = set(missing)
+        reached: set[int] = set()  # the endpoint rows paths of this γ reached
+        wave = sorted(missing)
+        while wave:
+            e, s, _, _ = track(problem, start.p0, p1, gamma, start.solutions[wave], wide=WIDE_POSE)
+            chain = []
+            for endpoint, st in zip(canonical(problem, e), s):
+                if st not in (OK, SINGULAR):
+                    failed |= st != DIVERGED
+                    ends += st == DIVERGED
+                    continue
+                new, row = found.place(endpoint, is_canonical=True, loose=st == SINGULAR)
+                if new:
+                    owner[row] = None
+                elif row in reached:  # two paths of this γ at one endpoint: one jumped
+                    failed = True
+                    continue
+                reached.add(row)
+                k = owner.get(row)
+                if not new and k is not None and k not in tracked:
+                    tracked.add(k)
+                    chain.append(k)
+            wave = chain
+        if not failed:
+            infinite = ends
+            break
     theta = np.array(found.rows).reshape(-1, problem.n)
     keep = own_rows(problem, theta)
-    accounted = len(found.rows) + int(diverged.sum())
+    accounted = len(found.rows) + diverged + infinite
     complete = start.certified and accounted == start.count
-    return Endpoints(theta[keep, :problem.joints], complete, start.count, start.count - accounted,
-                     int(diverged.sum()), np.array(singular, bool)[keep])
+    return Endpoints(theta[keep, :problem.joints], complete, start.count, max(start.count - accounted, 0), diverged + infinite,
+                     np.array(found.loose, bool)[keep])
 
 
 def own_rows(problem: Problem, theta: np.ndarray) -> np.ndarray:
