@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: e68f5b0f94357c15
+Content hash: c382efabdcacc3a9
 """

@@ -398,10 +398,11 @@ def test_missing_solutions_are_found_by_chains_in_one_round(monkeypatch):
     each start whose endpoint is missing to the start whose first-γ endpoint its path reached,
     finds every missing solution (a new γ permutes start and end solutions, so tracking the
     failed starts alone finds known ones again)."""
-    problem = homotopy.Problem.of(ikcounts.design("ARRRRR", seed=2))
+    chain = ikcounts.design("ARRRRR", seed=2)
+    problem = homotopy.Problem.of(chain)
     start = homotopy.prepare(problem, seed=0)
     assert start.count == 48
-    T = ikcounts.design("ARRRRR", seed=2).fk(np.random.default_rng(1).uniform(-1, 1, 6))
+    T = chain.fk(np.random.default_rng(1).uniform(-1, 1, 6))
     truth = homotopy.solve(problem, start, T)
     assert truth.failed == 0 and len(truth.theta) == 48
     real_track, gammas = homotopy.track, []

@@ -277,15 +277,12 @@ class _Index:
         """Adds θ unless it is already there; whether it was new."""
         return self.place(theta)[0]
 
-    def _key(self, theta) -> int:
-        return int(math.floor(theta[0].imag / LOOSE))
-
     def place(self, theta, is_canonical: bool = False, loose: bool = False) -> tuple[bool, int]:
         """Adds θ unless it is already there: (whether it was new, its row). is_canonical: θ is
         already canonical (a batch canonicalised at once). A refined θ that is a loose row's
         solution takes that row's place."""
         theta = np.asarray(theta) if is_canonical else canonical(self.problem, np.asarray(theta))
-        key = self._key(theta)
+        key = int(math.floor(theta[0].imag / LOOSE))
         for k in (key - 1, key, key + 1):
             for j in self.buckets.get(k, ()):
                 d = theta - self.rows[j]
