@@ -477,6 +477,7 @@ def time_ik6(pattern: str, poses: int, rng) -> dict:
     ms = np.array(times) * 1e3
     return {"pattern": pattern, "poses": poses, "median_ms": float(np.median(ms)), "max_ms": float(ms.max()),
             "prepare_s": prep, "first_call_ms": first * 1e3, "start_count": start.count, "start_certified": start.certified,
+            "start_how": start.how,
             "trace_s": trace_s, "trace_deviation": start.trace if start.traced else None, "witnesses": start.witnesses,
             "round_trips_found": found, "certified_poses": certified, "methods": methods}
 
@@ -627,7 +628,7 @@ def main(argv=None) -> int:
               f"{r['start_count']} solutions prepared in {r['prepare_s']:.1f} s, "
               + (f"trace test {'passed' if r['start_certified'] else 'FAILED'} in {r['trace_s']:.1f} s (deviation "
                  f"{r['trace_deviation']:.0e}, {r['witnesses']} witnesses)" if r["trace_s"] is not None else
-                 f"no trace test ({'two runs agree' if r['start_certified'] else 'not certified'})"))
+                 f"no trace test ({'' if r['start_certified'] else 'not '}certified: {r['start_how']})"))
     r = results["ik_local"]
     print(f"  ik_local n = 6: {r['us_per_converged']:.2f} µs per converged solve ({r['converged']:.1%} converged)")
     if results["make_generate_s"] is not None:

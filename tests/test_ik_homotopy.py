@@ -4,6 +4,8 @@ special designs, no false solutions, agreement with a dense multi-start search a
 eliminations of apair.ik, clear refusals."""
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -140,7 +142,7 @@ def test_start_system_is_cached(tmp_path, monkeypatch):
 def test_counts_agree_with_the_eliminations():
     """For n ≤ 4 the stored counts (homotopy, virtual joints) equal the complex counts of the
     independent eliminations of apair.ik at a random pose of a random design."""
-    rows = {r["pattern"]: r for r in ikcounts.load()}
+    rows = {r["pattern"]: r for r in homotopy.stored_counts()}
     rng = np.random.default_rng(0)
     for pattern in ("R", "A", "RR", "AR", "RRR", "ARR", "RRRR", "ARRA"):
         key = min(pattern, pattern[::-1])
@@ -150,9 +152,31 @@ def test_counts_agree_with_the_eliminations():
     assert rows["RRRRRR"]["count"] == 16 and rows["ARRRRR"]["count"] == 48
 
 
+def test_start_set_at_the_generic_count_is_certified_by_it():
+    """A start set that reaches its pattern's generic count ends there (one run, no check loops)
+    and is certified by it; below it (a special design, or a count not known) two runs must agree;
+    above it the set is not certified."""
+    assert homotopy.generic_count(homotopy.Problem.of(ikcounts.design("ARRRRR"))) == 48
+    assert homotopy.generic_count(homotopy.Problem.of(ikcounts.design("RRRRRA"))) == 48  # the reverse
+    assert homotopy.generic_count(homotopy.Problem.of(ikcounts.design("ARRRR"))) == 48
+    assert homotopy.generic_count(homotopy.Problem.of(ikcounts.design("RRRRA"))) == 0  # virtual joints: not stored
+    problem = homotopy.Problem.of(chain_of("RRRRRR", np.random.default_rng(2)))
+    start = homotopy.prepare(problem, generic=homotopy.generic_count(problem))
+    assert start.count == 16 and start.runs == [16] and start.certified
+    assert "generic count 16" in start.how
+    plain = homotopy.prepare(problem, generic=17)  # as if the pattern had 17: the runs decide
+    assert plain.count == 16 and plain.runs == [16, 16] and plain.certified
+    assert plain.how.startswith("two monodromy runs found it")
+    special = homotopy.Problem.of(chain_of("RRRRRR", np.random.default_rng(2), special=True))
+    wrist = homotopy.prepare(special, generic=homotopy.generic_count(special))
+    assert wrist.count == 8 and len(wrist.runs) >= 2 and wrist.certified
+    doubled = dataclasses.replace(start, generic=15)
+    assert "more solutions than the pattern's generic count 15" in doubled.how
+
+
 def test_count_of_a_pattern_is_recomputed():
     """The machinery behind the stored table, run again on small patterns."""
-    rows = {r["pattern"]: r for r in ikcounts.load()}
+    rows = {r["pattern"]: r for r in homotopy.stored_counts()}
     for pattern in ("RR", "RRRRRR"):
         assert ikcounts.count(pattern)["count"] == rows[pattern]["count"]
 

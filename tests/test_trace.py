@@ -131,7 +131,7 @@ def test_verdict_is_cached_and_shown(tmp_path, monkeypatch, capsys):
     assert not plain.traced and plain.certified
     assert cli(["ik-prepare", str(path), "--trace", "--quiet"]) == 0
     out = capsys.readouterr().out
-    assert "start system of 16 complex solutions, certified by the trace test" in out
+    assert "start system of 16 complex solutions, certified complete: the trace test passed" in out
     huge = dataclasses.replace(plain, solutions=np.zeros((trace.MAX_SOLUTIONS + 1, 6), complex))
     with pytest.raises(ValueError, match=r"^trace: the start set has 201 complex solutions"):
         trace.certify(homotopy.Problem.of(chain), huge)  # refused before any work

@@ -31,9 +31,9 @@ def _cmd_show(args) -> int:
 
 
 def _show_ik_counts(args) -> int:
-    from . import ikcounts
+    from . import homotopy
 
-    rows = ikcounts.load()
+    rows = homotopy.stored_counts()
     if args.json:
         print(json.dumps(rows, indent=1))
         return 0
@@ -41,7 +41,9 @@ def _show_ik_counts(args) -> int:
           "R: R-pair; a pattern and its reverse have the same count). n < 6: at a pose of the chain's own\n"
           "image. Computed by apair.ikcounts (make ik-counts) with the homotopy machinery of chain.ik;\n"
           "'how' lists the start set's monodromy runs (for n < 6 the 6-joint set with virtual joints);\n"
-          "certified: by the trace test where 'how' names one, else two runs found the count (weaker).")
+          "certified: by the trace test where 'how' names one, else two runs found the count (weaker).\n"
+          "No design has more solutions than its pattern's count, so chain.ik takes a start set that\n"
+          "reaches it as complete.")
     print(f"{'pattern':8s} {'count':>6s}  {'certified':9s}  how")
     for r in rows:
         print(f"{r['pattern']:8s} {r['count']:6d}  {'yes' if r['certified'] else 'no':9s}  {r['how']}")
@@ -58,14 +60,12 @@ def _cmd_ik_prepare(args) -> int:
         def progress(loops, count):
             print(f"\rmonodromy: loop {loops:4d}, {count:6d} points", end="", file=sys.stderr, flush=True)
     start = chain.prepare_ik(progress=progress, refresh=args.refresh, trace=args.trace)
+    from .trace import MAX_SOLUTIONS
     if progress:
         print(file=sys.stderr)
-    if start.traced:
-        state = (f"certified by the trace test (deviation {start.trace:.1e}, {start.witnesses} witnesses)"
-                 if start.certified else f"NOT complete: the trace test failed (deviation {start.trace:.1e})")
-    else:
-        state = ("certified (two monodromy runs agree; no trace test: --trace runs one)" if start.certified
-                 else "NOT certified (the independent runs disagree)")
+    state = f"{'certified' if start.certified else 'NOT certified'} complete: {start.how}"
+    if not start.traced and start.count <= MAX_SOLUTIONS and not start.generic == start.count:
+        state += "; --trace runs the trace test"
     print(f"{chain.name}: start system of {start.count} complex solutions, {state}; runs found {start.runs} "
           f"in {start.loops} loops ({start.seconds:.1f} s to compute; cached)")
     return 0

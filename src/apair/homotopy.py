@@ -30,12 +30,16 @@ reaches all of it:
   given up after 100 such steps: with another γ it takes another way). An endpoint left
   unrefined (SINGULAR) is one with another within LOOSE. The NumPy fallback has double only.
 - **Completeness**: a start set is `certified` by its trace test (apair.trace, passed to
-  `start_system` as `certify`) where one has run. Otherwise it is `certified` when two
-  independent monodromy runs (each from its own random start, each stable for STABLE loops) found
-  the same number, the union's, and CHECK_LOOPS further loops carry every solution without losing a
-  path. That is weaker: a solution that every run misses (far out in the complex, where paths lose
-  digits) goes unnoticed. A pose's answer is complete when, in addition, every path ended (finite,
-  or diverging to infinity) at a distinct point.
+  `start_system` as `certify`) where one has run. Otherwise, where it has as many solutions as the
+  pattern's generic count (`generic_count`, from `apair show ik_counts`): the generic count bounds
+  the isolated solutions of every design of the pattern (coefficient-parameter theory: the number
+  of nonsingular isolated solutions is the same at generic parameters and no larger at any), so
+  such a set has them all; monodromy stops as soon as it gets there. Otherwise it is `certified`
+  when two independent monodromy runs (each from its own random start, each stable for STABLE
+  loops) found the same number, the union's, and CHECK_LOOPS further loops carry every solution
+  without losing a path. That is weaker: a solution that every run misses (far out in the complex,
+  where paths lose digits) goes unnoticed. A pose's answer is complete when, in addition, every
+  path ended (finite, or diverging to infinity) at a distinct point.
 """
 from __future__ import annotations
 
@@ -52,7 +56,7 @@ import numpy as np
 
 from .study import from_matrix
 
-FORMAT = 2  # of the cached start systems
+FORMAT = 3  # of the cached start systems
 STABLE = 20  # loops in a row without a new solution that end a monodromy run
 MAX_LOOPS = 400
 CHECK_LOOPS = 3  # loops after the runs in which no path may be lost for a certified start set
@@ -211,6 +215,7 @@ class StartSystem:
     seconds: float
     trace: float = math.nan  # the trace test's relative deviation from affine (apair.trace); NaN: not run
     witnesses: int = 0  # the trace test's extra witness points
+    generic: int = 0  # the pattern's generic count the set was prepared against (generic_count); 0: none known
 
     @property
     def count(self) -> int:
@@ -221,12 +226,29 @@ class StartSystem:
         """Whether a trace test has judged this set (then `certified` is its verdict)."""
         return not math.isnan(self.trace)
 
+    @property
+    def how(self) -> str:
+        """How `certified` was decided, in words."""
+        if self.traced:
+            return (f"the trace test {'passed' if self.certified else 'failed'} (deviation {self.trace:.1e}, "
+                    f"{self.witnesses} witnesses)")
+        if self.generic and self.count == self.generic:
+            return f"it has the pattern's generic count {self.generic} (apair show ik_counts), which no design exceeds"
+        if self.generic and self.count > self.generic:
+            return (f"it has more solutions than the pattern's generic count {self.generic}: a solution is "
+                    "counted twice (or the stored count is short)")
+        agree = sum(c == self.count for c in self.runs) >= 2
+        return ("two monodromy runs found it" if self.certified else
+                "a path was lost in the check loops" if agree else "the monodromy runs disagree") + \
+            (f" (the pattern's generic count is {self.generic})" if self.generic else "")
+
     def save(self, path: Path) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
         with open(tmp, "wb") as f:
             np.savez(f, format=FORMAT, problem_key=self.problem_key, p0=self.p0, solutions=self.solutions, loops=self.loops, runs=np.array(self.runs),
-                     certified=self.certified, seconds=self.seconds, trace=self.trace, witnesses=self.witnesses)
+                     certified=self.certified, seconds=self.seconds, trace=self.trace, witnesses=self.witnesses,
+                     generic=self.generic)
         os.replace(tmp, path)
 
     @staticmethod
@@ -237,7 +259,7 @@ class StartSystem:
                     return None
                 return StartSystem(key, z["p0"], z["solutions"],
                                    int(z["loops"]), [int(x) for x in z["runs"]], bool(z["certified"]),
-                                   float(z["seconds"]), float(z["trace"]), int(z["witnesses"]))
+                                   float(z["seconds"]), float(z["trace"]), int(z["witnesses"]), int(z["generic"]))
         except (OSError, ValueError, KeyError):
             return None
 
@@ -580,8 +602,9 @@ def _seed_solution(problem: Problem, rng):
 
 
 def monodromy(problem: Problem, rng: np.random.Generator, stable: int = STABLE,
-              max_loops: int = MAX_LOOPS, progress=None, p0=None, known=None):
-    """All solutions at one generic pose by monodromy loops: (p0, solutions (k, n), loops)."""
+              max_loops: int = MAX_LOOPS, progress=None, p0=None, known=None, target: int = 0):
+    """All solutions at one generic pose by monodromy loops: (p0, solutions (k, n), loops). Ends
+    after `stable` loops in a row found nothing new, or once `target` (> 0) solutions are known."""
     index = _Index(problem)
     if p0 is None:
         theta, p0 = _seed_solution(problem, rng)
@@ -590,7 +613,7 @@ def monodromy(problem: Problem, rng: np.random.Generator, stable: int = STABLE,
         for s in known:
             index.add(s)
     quiet, loops = 0, 0
-    while quiet < stable and loops < max_loops:
+    while quiet < stable and loops < max_loops and not 0 < target <= len(index.rows):
         loops += 1
         pa, pb = random_pose(rng), random_pose(rng)
         cur = np.array(index.rows)
@@ -606,17 +629,20 @@ def monodromy(problem: Problem, rng: np.random.Generator, stable: int = STABLE,
     return p0, np.array(index.rows), loops
 
 
-def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4) -> StartSystem:
+def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4, generic: int = 0) -> StartSystem:
     """A start system: independent monodromy runs (each from its own random starting solution and
     pose), merged at the pose of the larger set (the other's solutions tracked there; where the
-    union grows, monodromy continues from it), at most `runs`; certified when two runs found the
-    union's count on their own and CHECK_LOOPS more loops lose no path."""
+    union grows, monodromy continues from it), at most `runs`. generic: the pattern's generic count
+    (generic_count; 0: not known), where monodromy stops and the set is certified (module
+    docstring). Below it, certified when two runs found the union's count on their own and
+    CHECK_LOOPS more loops lose no path."""
     t0 = time.perf_counter()
     rng = np.random.default_rng([seed, problem.n, problem.joints, 17])
-    p0, sols, loops = monodromy(problem, rng, progress=progress)
+    p0, sols, loops = monodromy(problem, rng, progress=progress, target=generic)
     counts = [len(sols)]
-    while len(counts) < runs and sum(c == len(sols) for c in counts) < 2:
-        q0, other, more = monodromy(problem, rng, progress=progress)
+    while (len(counts) < runs and sum(c == len(sols) for c in counts) < 2
+           and not 0 < generic <= len(sols)):
+        q0, other, more = monodromy(problem, rng, progress=progress, target=generic)
         loops += more
         counts.append(len(other))
         if len(other) > len(sols):  # merge into the larger set, at its pose
@@ -626,20 +652,40 @@ def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4) -> St
         for s in sols:
             index.add(s)
         if sum(index.add(s) for s in end[status == OK]):  # the union is larger: loop again from it
-            p0, sols, more = monodromy(problem, rng, progress=progress, p0=p0, known=index.rows)
+            p0, sols, more = monodromy(problem, rng, progress=progress, p0=p0, known=index.rows, target=generic)
             loops += more
-    # every solution is carried around CHECK_LOOPS more loops: a path that cannot be tracked (far out
-    # in the complex, where digits are lost) with any of RETRIES gammas marks a set whose missing
-    # members could hide there
-    lost = 0
-    for _ in range(CHECK_LOOPS):
-        pa, pb = random_pose(rng), random_pose(rng)
-        cur = sols
-        for a, b in ((p0, pa), (pa, pb), (pb, p0)):
-            cur, status = _segment(problem, a, b, cur, rng, retries=RETRIES)
-            lost += int(np.sum((status == FAILED) | (status == TOO_LONG)))
-    certified = bool(sum(c == len(sols) for c in counts) >= 2 and lost == 0)
-    return StartSystem(problem.key(), p0, sols, loops, counts, certified, time.perf_counter() - t0)
+    if generic and len(sols) >= generic:  # all of them, or one counted twice: no loops decide more
+        certified = len(sols) == generic
+    else:
+        # every solution is carried around CHECK_LOOPS more loops: a path that cannot be tracked (far
+        # out in the complex, where digits are lost) with any of RETRIES gammas marks a set whose
+        # missing members could hide there
+        lost = 0
+        for _ in range(CHECK_LOOPS):
+            pa, pb = random_pose(rng), random_pose(rng)
+            cur = sols
+            for a, b in ((p0, pa), (pa, pb), (pb, p0)):
+                cur, status = _segment(problem, a, b, cur, rng, retries=RETRIES)
+                lost += int(np.sum((status == FAILED) | (status == TOO_LONG)))
+        certified = bool(sum(c == len(sols) for c in counts) >= 2 and lost == 0)
+    return StartSystem(problem.key(), p0, sols, loops, counts, certified, time.perf_counter() - t0, generic=generic)
+
+
+def stored_counts() -> list[dict]:
+    """The generic counts of every pattern (src/apair/data/ik_counts.json, written by apair.ikcounts)."""
+    from importlib import resources
+
+    return json.loads(resources.files("apair").joinpath("data/ik_counts.json").read_text())["counts"]
+
+
+def generic_count(problem: Problem) -> int:
+    """The certified generic number of solutions of the problem's pattern from the stored counts,
+    or 0. For 6 joints the pattern or its reverse; for fewer, the start set with the virtual joints,
+    stored for the pattern as written."""
+    pattern = "".join("A" if k else "R" for k in problem.kind[:problem.joints])
+    rows = stored_counts()
+    names = {pattern, pattern[::-1]} if problem.joints == 6 else {pattern}
+    return next((int(r["start_count"]) for r in rows if r["pattern"] in names and r["certified"]), 0)
 
 
 def _cache_path(problem: Problem) -> Path:
@@ -661,7 +707,7 @@ def start_system(problem: Problem, progress=None, refresh: bool = False, certify
         if start is not None and (certify is None or start.traced):
             return start
     if start is None:
-        start = prepare(problem, progress=progress)
+        start = prepare(problem, progress=progress, generic=generic_count(problem))
     if certify is not None:
         start = certify(problem, start, progress=progress)
     try:

@@ -155,12 +155,5 @@ def _write(out: Path, rows: list[dict], old: dict) -> None:
     out.write_text(json.dumps({"counts": rows + [r for p, r in old.items() if p not in done]}, indent=1) + "\n")
 
 
-def load() -> list[dict]:
-    """The stored counts (src/apair/data/ik_counts.json)."""
-    from importlib import resources
-
-    return json.loads(resources.files("apair").joinpath("data/ik_counts.json").read_text())["counts"]
-
-
 if __name__ == "__main__":
     sys.exit(main())
