@@ -5,6 +5,7 @@ eliminations of apair.ik, clear refusals."""
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 import numpy as np
 import pytest
@@ -172,6 +173,30 @@ def test_start_set_at_the_generic_count_is_certified_by_it():
     assert wrist.count == 8 and len(wrist.runs) >= 2 and wrist.certified
     doubled = dataclasses.replace(start, generic=15)
     assert "more solutions than the pattern's generic count 15" in doubled.how
+
+
+def test_a_path_diverging_on_the_way_to_a_generic_pose_is_tracked_again(monkeypatch):
+    """Every solution at a generic pose is finite: a path of a monodromy check loop that diverged
+    lost its way and gets a new γ (a special six-A-pair design lost one so and went uncertified)."""
+    problem = homotopy.Problem.of(chain_of("RRRRRR", np.random.default_rng(2)))
+    start = homotopy.prepare(problem, generic=16)
+    real_track, calls = homotopy.track, []
+
+    def track(problem, p0, p1, gamma, rows, **kw):
+        e, s, steps, cond = real_track(problem, p0, p1, gamma, rows, **kw)
+        calls.append(len(rows))
+        if len(calls) == 1:
+            s = s.copy()
+            s[:3] = homotopy.DIVERGED
+        return e, s, steps, cond
+
+    monkeypatch.setattr(homotopy, "track", track)
+    pa = homotopy.random_pose(np.random.default_rng(4))
+    _, status = homotopy._segment(problem, start.p0, pa, start.solutions, np.random.default_rng(5), finite=True)
+    assert calls == [16, 3] and np.all(status == homotopy.OK)
+    calls.clear()
+    _, status = homotopy._segment(problem, start.p0, pa, start.solutions, np.random.default_rng(5))
+    assert calls == [16] and np.sum(status == homotopy.DIVERGED) == 3  # toward a pose that need not be generic
 
 
 def test_count_of_a_pattern_is_recomputed():
@@ -478,3 +503,13 @@ def test_tracking_in_a_forked_child(monkeypatch, tracked):
     with multiprocessing.get_context("fork").Pool(1) as pool:
         there = pool.apply_async(chain.ik, (T,)).get(timeout=120)
     assert np.array_equal(here, there)
+
+
+def test_canonical_passes_failed_endpoints_quietly():
+    """A failed path's endpoint (NaN, inf) goes through canonical without a RuntimeWarning."""
+    problem = homotopy.Problem.of(chain_of("ARRRRR", np.random.default_rng(0)))
+    theta = np.array([[np.nan] * 6, [np.inf + 1j] * 6, [7.0 + 0.5j] * 6])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = homotopy.canonical(problem, theta)
+    assert np.all(np.isnan(out[:2].real)) and np.allclose(out[2], [7 - 4 * np.pi + 0.5j] + [7 - 2 * np.pi + 0.5j] * 5)

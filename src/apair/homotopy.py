@@ -279,7 +279,8 @@ def canonical(problem: Problem, theta: np.ndarray) -> np.ndarray:
     """θ with its real part in (−π, π] (R-pair) or (−2π, 2π] (A-pair), the imaginary part kept."""
     half = np.where(problem.kind == 0, np.pi, 2 * np.pi)
     re = np.real(theta)
-    return (re - 2 * half * np.ceil((re - half) / (2 * half))) + 1j * np.imag(theta)
+    with np.errstate(invalid="ignore"):  # a failed path's endpoint (NaN, inf) stays what it is
+        return (re - 2 * half * np.ceil((re - half) / (2 * half))) + 1j * np.imag(theta)
 
 
 class _Index:
@@ -563,12 +564,13 @@ def track_system(evaluate, gamma, start: np.ndarray, angles: int):
     return v, status.astype(np.int32), steps.astype(np.int32), cond
 
 
-def _segment(problem: Problem, a, b, start: np.ndarray, rng, retries: int = 2):
+def _segment(problem: Problem, a, b, start: np.ndarray, rng, retries: int = 2, finite: bool = False):
     """start tracked from pose a to b, the paths that failed again with a new γ (a path that fails
-    in a loop of monodromy would hide its solution's images)."""
+    in a loop of monodromy would hide its solution's images). finite: b is a generic pose, where
+    every solution is finite, so a path that diverged failed too."""
     end, status, _, _ = track(problem, a, b, _unit_gamma(rng), start)
     for _ in range(retries):
-        bad = np.flatnonzero((status == FAILED) | (status == TOO_LONG))
+        bad = np.flatnonzero((status == FAILED) | (status == TOO_LONG) | (finite & (status == DIVERGED)))
         if len(bad) == 0:
             break
         e, s, _, _ = track(problem, a, b, _unit_gamma(rng), start[bad])
@@ -658,15 +660,15 @@ def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4, gener
         certified = len(sols) == generic
     else:
         # every solution is carried around CHECK_LOOPS more loops: a path that cannot be tracked (far
-        # out in the complex, where digits are lost) with any of RETRIES gammas marks a set whose
-        # missing members could hide there
+        # out in the complex, where digits are lost; diverging, where every solution is finite)
+        # with any of RETRIES gammas marks a set whose missing members could hide there
         lost = 0
         for _ in range(CHECK_LOOPS):
             pa, pb = random_pose(rng), random_pose(rng)
             cur = sols
             for a, b in ((p0, pa), (pa, pb), (pb, p0)):
-                cur, status = _segment(problem, a, b, cur, rng, retries=RETRIES)
-                lost += int(np.sum((status == FAILED) | (status == TOO_LONG)))
+                cur, status = _segment(problem, a, b, cur, rng, retries=RETRIES, finite=True)
+                lost += int(np.sum((status == FAILED) | (status == TOO_LONG) | (status == DIVERGED)))
         certified = bool(sum(c == len(sols) for c in counts) >= 2 and lost == 0)
     return StartSystem(problem.key(), p0, sols, loops, counts, certified, time.perf_counter() - t0, generic=generic)
 
