@@ -93,7 +93,7 @@ $(BENCH_STAMP): pyproject.toml | $(DEPS_STAMP)
 
 # The generic inverse-kinematics solution counts of every R/A pattern (apair show ik_counts):
 # monodromy on a random design of each pattern, and the trace test for start sets of up to 48
-# solutions, slower than `make` (about an hour). `... --trace N --update` judges the sets of up to N
+# solutions, slower than `make` (about half an hour). `... --trace N --update` judges the sets of up to N
 # solutions of the stored rows again and keeps the others.
 ik-counts: install
 	$(PY) -m apair.ikcounts src/apair/data/ik_counts.json 6 --trace 48

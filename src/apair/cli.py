@@ -41,7 +41,8 @@ def _show_ik_counts(args) -> int:
           "R: R-pair; a pattern and its reverse have the same count). n < 6: at a pose of the chain's own\n"
           "image. Computed by apair.ikcounts (make ik-counts) with the homotopy machinery of chain.ik;\n"
           "'how' lists the start set's monodromy runs (for n < 6 the 6-joint set with virtual joints);\n"
-          "certified: by the trace test where 'how' names one, else two runs found the count (weaker).\n"
+          "certified: by the trace test where 'how' names one, else two runs found the count and a run\n"
+          "on a second design found no more (weaker).\n"
           "No design has more solutions than its pattern's count, so chain.ik takes a start set that\n"
           "reaches it as complete.")
     print(f"{'pattern':8s} {'count':>6s}  {'certified':9s}  how")
@@ -51,6 +52,8 @@ def _show_ik_counts(args) -> int:
 
 
 def _cmd_ik_prepare(args) -> int:
+    from .trace import MAX_SOLUTIONS
+
     chain = load(args.file)
     if chain.n < 5:
         raise ValueError(f"{args.file}: {chain.n} joints; start systems are for 5 and 6 joints (fewer are solved "
@@ -60,11 +63,10 @@ def _cmd_ik_prepare(args) -> int:
         def progress(loops, count):
             print(f"\rmonodromy: loop {loops:4d}, {count:6d} points", end="", file=sys.stderr, flush=True)
     start = chain.prepare_ik(progress=progress, refresh=args.refresh, trace=args.trace)
-    from .trace import MAX_SOLUTIONS
     if progress:
         print(file=sys.stderr)
     state = f"{'certified' if start.certified else 'NOT certified'} complete: {start.how}"
-    if not start.traced and start.count <= MAX_SOLUTIONS and not start.generic == start.count:
+    if not start.traced and start.count <= MAX_SOLUTIONS and start.generic != start.count:
         state += "; --trace runs the trace test"
     print(f"{chain.name}: start system of {start.count} complex solutions, {state}; runs found {start.runs} "
           f"in {start.loops} loops ({start.seconds:.1f} s to compute; cached)")
