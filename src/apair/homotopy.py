@@ -227,6 +227,11 @@ class StartSystem:
         return not math.isnan(self.trace)
 
     @property
+    def runs_agree(self) -> bool:
+        """Whether two independent monodromy runs found the set's count on their own."""
+        return sum(c == self.count for c in self.runs) >= 2
+
+    @property
     def how(self) -> str:
         """How `certified` was decided, in words."""
         if self.traced:
@@ -237,9 +242,8 @@ class StartSystem:
         if self.generic and self.count > self.generic:
             return (f"it has more solutions than the pattern's generic count {self.generic}: a solution is "
                     "counted twice (or the stored count is short)")
-        agree = sum(c == self.count for c in self.runs) >= 2
         return ("two monodromy runs found it" if self.certified else
-                "a path was lost in the check loops" if agree else "the monodromy runs disagree") + \
+                "a path was lost in the check loops" if self.runs_agree else "the monodromy runs disagree") + \
             (f" (the pattern's generic count is {self.generic})" if self.generic else "")
 
     def save(self, path: Path) -> None:
@@ -564,13 +568,18 @@ def track_system(evaluate, gamma, start: np.ndarray, angles: int):
     return v, status.astype(np.int32), steps.astype(np.int32), cond
 
 
+def _lost(status: np.ndarray, finite: bool) -> np.ndarray:
+    """Which paths lost their way: failed, too long, or (finite: toward a generic pose, where every
+    solution is finite) diverged."""
+    return (status == FAILED) | (status == TOO_LONG) | (finite & (status == DIVERGED))
+
+
 def _segment(problem: Problem, a, b, start: np.ndarray, rng, retries: int = 2, finite: bool = False):
-    """start tracked from pose a to b, the paths that failed again with a new γ (a path that fails
-    in a loop of monodromy would hide its solution's images). finite: b is a generic pose, where
-    every solution is finite, so a path that diverged failed too."""
+    """start tracked from pose a to b, the paths that lost their way (`_lost`) again with a new γ (a
+    path that fails in a loop of monodromy would hide its solution's images)."""
     end, status, _, _ = track(problem, a, b, _unit_gamma(rng), start)
     for _ in range(retries):
-        bad = np.flatnonzero((status == FAILED) | (status == TOO_LONG) | (finite & (status == DIVERGED)))
+        bad = np.flatnonzero(_lost(status, finite))
         if len(bad) == 0:
             break
         e, s, _, _ = track(problem, a, b, _unit_gamma(rng), start[bad])
@@ -656,7 +665,7 @@ def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4, gener
         if sum(index.add(s) for s in end[status == OK]):  # the union is larger: loop again from it
             p0, sols, more = monodromy(problem, rng, progress=progress, p0=p0, known=index.rows, target=generic)
             loops += more
-    if generic and len(sols) >= generic:  # all of them, or one counted twice: no loops decide more
+    if 0 < generic <= len(sols):  # all of them, or one counted twice: no loops decide more
         certified = len(sols) == generic
     else:
         # every solution is carried around CHECK_LOOPS more loops: a path that cannot be tracked (far
@@ -668,7 +677,7 @@ def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4, gener
             cur = sols
             for a, b in ((p0, pa), (pa, pb), (pb, p0)):
                 cur, status = _segment(problem, a, b, cur, rng, retries=RETRIES, finite=True)
-                lost += int(np.sum((status == FAILED) | (status == TOO_LONG) | (status == DIVERGED)))
+                lost += int(np.sum(_lost(status, True)))
         certified = bool(sum(c == len(sols) for c in counts) >= 2 and lost == 0)
     return StartSystem(problem.key(), p0, sols, loops, counts, certified, time.perf_counter() - t0, generic=generic)
 

@@ -109,7 +109,7 @@ def count(pattern: str, seed: int = 0, progress=None, trace_upto: int = 0) -> di
         other = homotopy.Problem.of(design(pattern, seed + 1))
         second = len(homotopy.monodromy(other, np.random.default_rng([seed + 1, 23]), progress=progress)[1])
         how += f"; a second design: one run found {second}"
-        certified = bool(sum(r == start.count for r in start.runs) >= 2 and second <= start.count)
+        certified = start.runs_agree and second <= start.count
     if pattern in KNOWN:
         how += f"; known: {KNOWN[pattern]}"
     return {"pattern": pattern, "joints": len(pattern), "count": found, "start_count": start.count,
