@@ -15,10 +15,10 @@ all: generate install varieties lib examples demo
 $(PY):
 	$(PYTHON) -m venv $(VENV)
 
-# Dependencies (and a first install of the package) whenever pyproject.toml changes.
+# Dependencies (and a first, editable install of the package) whenever pyproject.toml changes.
 $(DEPS_STAMP): pyproject.toml setup.py | $(PY)
 	$(PY) -m pip install --quiet --upgrade pip "setuptools>=77" wheel
-	$(PY) -m pip install --quiet ".[dev]"
+	$(PY) -m pip install --quiet -e ".[dev]"
 	touch $@
 
 venv: $(DEPS_STAMP)
@@ -30,9 +30,17 @@ generate: $(DEPS_STAMP)
 varieties: install
 	PYTHONPATH=. $(PY) -m codegen.varieties
 
-# Non-editable install of the runtime with the current generated/ (builds the C kernels too).
-install: $(DEPS_STAMP)
-	$(PY) -m pip install --quiet --no-deps --no-build-isolation --force-reinstall .
+# The package is installed editable: the source tree is the package (src/apair, with generated/,
+# derivations/ and codegen/ mapped into it as apair.generated, apair.derivations, apair.codegen), so
+# the tests see an edit of Python at once. Only the C binding apair._native is built, in place,
+# and rebuilt when its sources change.
+EXT_SUFFIX := $(shell $(PYTHON) -c "import sysconfig; print(sysconfig.get_config_var('EXT_SUFFIX'))")
+NATIVE := src/apair/_native$(EXT_SUFFIX)
+NATIVE_SOURCES = $(wildcard generated/c/*.c generated/c/*.h src/csrc/*.c src/csrc/*.h) src/apair/_native.c setup.py
+install: $(NATIVE)
+$(NATIVE): $(DEPS_STAMP) $(NATIVE_SOURCES)
+	$(PY) -m pip install --quiet --no-deps --no-build-isolation -e .
+	touch $@
 
 # The C kernels as a plain shared library, built with the strict flags users may have: one object
 # per generated source, compiled in parallel on every core.
@@ -61,7 +69,7 @@ check: install
 	rm -rf $(CHECK_DIR) $(CHECK_DIR)-example
 	PYTHONPATH=. $(PY) -m codegen --out $(CHECK_DIR)
 	PYTHONPATH=. $(PY) -m codegen.varieties --out $(CHECK_DIR)
-	diff -r -x __pycache__ generated $(CHECK_DIR) || \
+	diff -r -x __pycache__ -x ik_counts.json generated $(CHECK_DIR) || \
 	  (echo "generated/ is out of date with the derivations: run make generate and commit" >&2; exit 1)
 	$(EXAMPLE_CODEGEN) $(CHECK_DIR)-example
 	diff -r $(EXAMPLE_CODE) $(CHECK_DIR)-example || \
@@ -96,10 +104,10 @@ $(BENCH_STAMP): pyproject.toml | $(DEPS_STAMP)
 # solutions, slower than `make` (about half an hour). `... --trace N --update` judges the sets of up to N
 # solutions of the stored rows again and keeps the others.
 ik-counts: install
-	$(PY) -m apair.ikcounts src/apair/data/ik_counts.json 6 --trace 48
+	$(PY) -m apair.ikcounts generated/ik_counts.json 6 --trace 48
 
 bench: install $(BENCH_STAMP)
 	PYTHONPATH=. $(PY) bench/run.py $(BENCH_ARGS)
 
 clean:
-	rm -rf build .venv *.egg-info src/*.egg-info
+	rm -rf build .venv *.egg-info src/*.egg-info src/apair/_native*.so

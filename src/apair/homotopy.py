@@ -683,10 +683,10 @@ def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4, gener
 
 
 def stored_counts() -> list[dict]:
-    """The generic counts of every pattern (src/apair/data/ik_counts.json, written by apair.ikcounts)."""
+    """The generic counts of every pattern (generated/ik_counts.json, written by apair.ikcounts)."""
     from importlib import resources
 
-    return json.loads(resources.files("apair").joinpath("data/ik_counts.json").read_text())["counts"]
+    return json.loads(resources.files("apair.generated").joinpath("ik_counts.json").read_text())["counts"]
 
 
 def generic_count(problem: Problem) -> int:

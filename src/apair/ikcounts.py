@@ -1,6 +1,6 @@
 """The generic number of complex inverse-kinematics solutions of every R/A pattern of 1 to 6 joints,
 computed by the machinery `AChain.ik` uses (apair.homotopy): `make ik-counts` (python -m
-apair.ikcounts) writes src/apair/data/ik_counts.json, and `apair show ik_counts` prints it.
+apair.ikcounts) writes generated/ik_counts.json, and `apair show ik_counts` prints it.
 
 Each pattern gets a random design of generic geometry (no zero lengths, no parallel or
 perpendicular axes). Its start system (the complete solution set at a generic complex pose, by

@@ -12,6 +12,7 @@ import hashlib
 import keyword
 import re
 from functools import lru_cache
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -54,12 +55,12 @@ def toolkit_digest() -> str:
 
     from . import __version__
 
-    root = Path(__file__).resolve().parent
     h = hashlib.sha256(f"apair {__version__} sympy {sympy.__version__}\0".encode())
-    for folder in ("derivations", "codegen", "codegen/templates"):
-        for path in sorted((root / folder).glob("*")):
-            if path.is_file() and path.suffix in (".py", ".j2"):
-                h.update(f"{folder}/{path.name}\0".encode() + path.read_bytes() + b"\0")
+    for package in ("derivations", "codegen"):
+        root = Path(str(resources.files(f"apair.{package}")))
+        for path in sorted(root.rglob("*")):
+            if path.is_file() and path.suffix in (".py", ".j2", ".c", ".h") and "__pycache__" not in path.parts:
+                h.update(f"{package}/{path.relative_to(root).as_posix()}\0".encode() + path.read_bytes() + b"\0")
     return h.hexdigest()
 
 
@@ -232,7 +233,7 @@ def build(chain, kernels=None) -> tuple[Path, str, tuple[str, ...]] | None:
     files = render(chain, name, "AChain.specialise()", kernels, code=code)
     files[f"{name}_registry.c"] = emitter.Emitter().render_chain_registry(code[0], name, digest)
     folder.parent.mkdir(parents=True, exist_ok=True)
-    include = Path(_kernels.__file__).parent / "generated" / "c"
+    include = Path(str(resources.files("apair.generated"))) / "c"
     with tempfile.TemporaryDirectory(dir=folder.parent, prefix=f".{digest}-") as tmp:
         work = Path(tmp) / digest
         work.mkdir()
