@@ -8,7 +8,7 @@ DEPS_STAMP := $(VENV)/.deps-stamp
 CFLAGS_STRICT := -std=c99 -Wall -Wextra -Werror -pedantic -O2
 CHECK_DIR := build/check-generated
 
-.PHONY: all venv generate install varieties lib examples demo check test bench clean ik-counts browser pictures
+.PHONY: all venv generate install varieties lib examples demo check test test-fast lint docs bench clean ik-counts browser pictures
 
 all: generate install varieties lib examples demo
 
@@ -78,6 +78,22 @@ check: install
 test: install lib check browser
 	$(PY) -m pytest -q
 
+# The fast tier (a few minutes): every test not marked slow, without regenerating generated/.
+test-fast: install lib
+	$(PY) -m pytest -q -m "not slow"
+
+# Lint, format, types and the import graph (a layered tree, .importlinter); the same checks run
+# before a commit with `pre-commit install` (.pre-commit-config.yaml).
+lint: $(DEPS_STAMP)
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+	$(BIN)/mypy
+	$(BIN)/lint-imports --config .importlinter
+
+# The documentation site (MkDocs) in build/site; any warning or broken link fails the build.
+docs: $(DEPS_STAMP)
+	$(BIN)/mkdocs build --strict
+
 # The viewer's test drives Debian's Chromium (Playwright, from the test extra, launches it):
 # installed here from the system packages when it is missing.
 CHROMIUM := /usr/bin/chromium
@@ -104,7 +120,7 @@ $(BENCH_STAMP): pyproject.toml | $(DEPS_STAMP)
 # solutions, slower than `make` (about half an hour). `... --trace N --update` judges the sets of up to N
 # solutions of the stored rows again and keeps the others.
 ik-counts: install
-	$(PY) -m apair.ikcounts generated/ik_counts.json 6 --trace 48
+	$(PY) -m apair.ik.homotopy.counts generated/ik_counts.json 6 --trace 48
 
 bench: install $(BENCH_STAMP)
 	PYTHONPATH=. $(PY) bench/run.py $(BENCH_ARGS)

@@ -434,7 +434,7 @@ def random_pattern_chain(pattern: str, rng) -> apair.AChain:
                         rng.uniform(-1.0, 1.0, n))
 
 
-TRACE_MAX = 48  # start sets the bench certifies by the trace test (larger ones: see apair.trace)
+TRACE_MAX = 48  # start sets the bench certifies by the trace test (larger ones: see apair.ik.homotopy.trace)
 
 
 def time_ik6(pattern: str, poses: int, rng) -> dict:

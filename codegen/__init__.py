@@ -1,4 +1,4 @@
-"""Code generation: kernel specs -> CSE -> jinja2 templates -> generated/ (one emitter).
+"""Code generation: kernel specs -> lowering (CSE, ...) -> one backend per target -> generated/.
 
 codegen and derivations are sibling packages: top-level in the source tree (`python -m codegen`
 regenerates generated/), `apair.codegen` and `apair.derivations` in an installed apair, which

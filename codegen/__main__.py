@@ -2,8 +2,9 @@
 
 The work is split into jobs: one per derivation, or one per part for a derivation that declares
 `PARTS` (then `derive(part)` returns that part's sets and specs). Each job derives, lowers (CSE)
-and prints its kernels in a worker process; the results are put back in the canonical order
-(derivation, then part), so the output does not depend on which worker finished first.
+and prints its kernels in a worker process (lowering/); the results are put back in the canonical
+order (derivation, then part), so the output does not depend on which worker finished first. The
+backends then render them (render.py: C, NumPy, JavaScript, the polynomial sets, the manifest).
 """
 from __future__ import annotations
 
@@ -15,7 +16,10 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from . import derivation
-from .emitter import Emitter, OutputError, lower, render_polynomials, write
+from .backends.polynomials import render as render_polynomials
+from .lowering import lower
+from .output import OutputError, write
+from .render import render_all
 
 DERIVATIONS = ("apair_collisions", "apair_pair", "apair_dynamics", "chain_kinematics", "chain_dynamics",
                "chain_variety", "chain_ik", "chain_ik6r", "chain_ik1a5r")
@@ -73,7 +77,7 @@ def main(argv=None) -> int:
         print(f"derived and lowered {label}: {len(kernels)} kernels, {len(polys) // 3} polynomial sets "
               f"({seconds:.1f} s)", file=sys.stderr)
     t0 = time.perf_counter()
-    files = Emitter().render(lowered, poly_files)
+    files = render_all(lowered, poly_files)
     try:
         changed = write(files, args.out, clean=args.only is None)
     except OutputError as exc:

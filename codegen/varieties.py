@@ -14,8 +14,9 @@ import time
 from pathlib import Path
 
 from . import derivation
-from .emitter import OutputError, content_hash, write
-from .polynomials import render_polynomial_set
+from .backends.polynomials import render_polynomial_set
+from .hashing import content_hash
+from .output import OutputError, write
 
 _spec = derivation("spec")
 Entry, PolynomialSet = _spec.Entry, _spec.PolynomialSet
@@ -61,7 +62,8 @@ def main(argv=None) -> int:
             print(f"variety of {path.name}: {len(ps.entries)} equations ({time.perf_counter() - t0:.1f} s)",
                   file=sys.stderr)
     try:
-        changed = write(files, args.out, clean=False)
+        # the variety files are this generator's own, beside generated/'s manifest (not in it)
+        changed = write(files, args.out, clean=False, force=True)
     except OutputError as exc:
         print(f"python -m codegen.varieties: error: {exc}", file=sys.stderr)
         return 2

@@ -1,9 +1,10 @@
-"""`make pictures`: the README's pictures of the two exits, from examples/4a_chain.toml.
+"""`make pictures`: the documentation's pictures of the two exits, from examples/4a_chain.toml.
 
 docs/images/mujoco.png: the exported MuJoCo model after 0.2 s of free motion from keyframe 0,
 rendered off-screen by MuJoCo (MUJOCO_GL=egl); docs/images/viewer.png: `apair view`'s page in
 headless Chromium. Not part of `make`: off-screen OpenGL is not on every machine.
 """
+
 import os
 import sys
 import tempfile
@@ -12,10 +13,9 @@ from pathlib import Path
 os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
 
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
+import mujoco
 
-from apair import io, mjcf, view  # noqa: E402
+from apair import io, mjcf, view
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "images"
@@ -46,8 +46,10 @@ def viewer_shot(chain):
     with tempfile.TemporaryDirectory() as tmp:
         page_file = view.write(chain, Path(tmp) / "view.html", workspace=3000)
         with sync_playwright() as p:
-            b = p.chromium.launch(executable_path="/usr/bin/chromium",
-                                  args=["--no-sandbox", "--disable-gpu", "--disable-background-networking"])
+            b = p.chromium.launch(
+                executable_path="/usr/bin/chromium",
+                args=["--no-sandbox", "--disable-gpu", "--disable-background-networking"],
+            )
             page = b.new_page(viewport={"width": 1000, "height": 560})
             page.goto(page_file.as_uri())
             page.wait_for_selector("body[data-ready='1']")

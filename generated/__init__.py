@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: c382efabdcacc3a9
+Content hash: 45992f3230f49ece
 """

@@ -377,8 +377,10 @@ def test_ik4_kernels_under_sanitizers(tmp_path):
 
     import apair
     from apair import ik
+    from apair.ik import elimination4, joints, pencil, poses
+    from apair.study import conjugate, multiply
 
-    native = ik._native()
+    native = elimination4.native_in_use()
     if native is None:
         pytest.skip("the compiled C kernels are not installed")
     if not sanitizers_link("gcc", tmp_path):
@@ -396,16 +398,16 @@ def test_ik4_kernels_under_sanitizers(tmp_path):
     # of 1000 on some), so else the first pose with an accepted root (status 0)
     first = None
     for _ in range(100):
-        target = ik._study(chain.fk(rng.uniform(-np.pi, np.pi, 4)))
+        target = poses.study_point(chain.fk(rng.uniform(-np.pi, np.pi, 4)))
         target[4:] /= solver.scale
         if elim.pre is not None:
-            target = ik.multiply(elim.pre, ik.conjugate(target))
-        C = np.ascontiguousarray(elim.image @ ik._left(target).T)
-        f, g, M = native.ik4_pencil(C, Qf, af, Qg, ag, ik.LEAD_COND, 3, ik.DEFLATE_TOL)
+            target = multiply(elim.pre, conjugate(target))
+        C = np.ascontiguousarray(elim.image @ joints.left_matrix(target).T)
+        f, g, M = native.ik4_pencil(C, Qf, af, Qg, ag, pencil.LEAD_COND, 3, pencil.DEFLATE_TOL)
         u3 = np.linalg.eigvals(M)
         u3 = np.sort(u3[np.abs(u3.imag) <= 1e-6].real)
         N = f.shape[1] + g.shape[1] - 2
-        screen = native.ik4_screen(u3, C, f, g, elim.Q, ik._PROBE[:N], ik._SCREEN_TOL)
+        screen = native.ik4_screen(u3, C, f, g, elim.Q, pencil.PROBE[:N], elimination4._SCREEN_TOL)
         if np.any(screen[0] == 0):
             first = first or (C, f, g, M, u3, N, screen)
             if np.any(screen[0] == 3):
@@ -415,15 +417,16 @@ def test_ik4_kernels_under_sanitizers(tmp_path):
     W = screen[2][screen[0] == 0]
     j2 = elim.joints[1]
     joint = np.array([0.0, j2.delta, j2.offset, j2.sign])
-    left = native.ik4_left(W, elim.Zmap, j2.P, joint, ik.LEFT_TOL)
+    left = native.ik4_left(W, elim.Zmap, j2.P, joint, elimination4.LEFT_TOL)
     assert len(W) >= 1 and np.all(left[0] != 1)
     d3, d4 = C.shape[0] - 1, C.shape[1] - 1
     src = "\n".join([
         '#include <stdio.h>', '#include "apair.h"',
         c_array("C", C), c_array("Qf", Qf), c_array("Qg", Qg), c_array("af", af, "int"), c_array("ag", ag, "int"),
-        c_array("u3", u3), c_array("Q", elim.Q), c_array("probe", ik._PROBE[:N]), c_array("stol", ik._SCREEN_TOL),
+        c_array("u3", u3), c_array("Q", elim.Q), c_array("probe", pencil.PROBE[:N]),
+        c_array("stol", elimination4._SCREEN_TOL),
         c_array("W", W), c_array("Zmap", elim.Zmap), c_array("P2", j2.P), c_array("joint", joint),
-        c_array("ltol", ik.LEFT_TOL),
+        c_array("ltol", elimination4.LEFT_TOL),
         "static double f[289], g[289], M[512 * 512], u4[64], Wo[512], rel[64], u1[64], u2[128];",
         "static double two[256], W2[1024], rel2[128];",
         "static int status[64], lstatus[64], ok[128], two_ok[128];",
@@ -431,7 +434,7 @@ def test_ik4_kernels_under_sanitizers(tmp_path):
         "const apair_kernel *apair_find_kernel(const char *name) { (void)name; return NULL; }",
         "int main(void) {",
         "    int size = 0, i;",
-        f"    if (apair_ik4_pencil({d3}, {d4}, C, Qf, af, Qg, ag, {ik.LEAD_COND!r}, 3, {ik.DEFLATE_TOL!r}, f, g, M, &size)) return 1;",
+        f"    if (apair_ik4_pencil({d3}, {d4}, C, Qf, af, Qg, ag, {pencil.LEAD_COND!r}, 3, {pencil.DEFLATE_TOL!r}, f, g, M, &size)) return 1;",
         '    printf("size %d\\nM", size);',
         '    for (i = 0; i < size * size; i++) printf(" %.17g", M[i]);',
         f"    if (apair_ik4_screen({len(u3)}, u3, {d3}, {d4}, C, f, {f.shape[0] - 1}, {f.shape[1] - 1}, g, "

@@ -6,7 +6,8 @@ import pytest
 from scipy.optimize import least_squares
 
 import apair
-from apair.study import from_matrix
+from apair.ik import elimination4, joints, pencil, poses
+from apair.study import conjugate, from_matrix, multiply
 
 
 def random_chain(rng, n, kinds="s") -> apair.AChain:
@@ -241,17 +242,17 @@ def test_forward_and_reversed_eliminations_agree():
             continue
         T = chain.fk(q)
         solver = ik.Solver(chain)
-        target = ik._study(T)
+        target = poses.study_point(T)
         target[4:] /= solver.scale
         counts = []
         for reverse in (False, True):
             try:
                 cands = solver._elimination(reverse).candidates(target, False)
-            except ik._Degenerate:
+            except pencil.Degenerate:
                 break
-            real = [c for c in cands if np.all(np.abs(np.imag(c)) <= ik.CAND_TOL * (1 + np.abs(c)))]
-            q_all = ik._with_twins(chain, solver._elimination(reverse).angles(real))
-            counts.append(len(ik._refine(chain, q_all, T, 1e-9)[0]))
+            real = [c for c in cands if np.all(np.abs(np.imag(c)) <= elimination4.CAND_TOL * (1 + np.abs(c)))]
+            q_all = poses.with_twins(chain, solver._elimination(reverse).angles(real))
+            counts.append(len(poses.refine(chain, q_all, T, 1e-9)[0]))
         if len(counts) == 2 and min(counts) > 0:
             assert counts[0] == counts[1], (chain, q)
             compared += 1
@@ -283,14 +284,12 @@ def test_coaxial_revolute_pairs_are_refused_as_a_curve(n):
 
 def forward_solutions(solver, chain, T):
     """The forward elimination's verified solutions alone (no reversed chain, no local search)."""
-    from apair import ik
-
-    target = ik._study(T)
+    target = poses.study_point(T)
     target[4:] /= solver.scale
     elim = solver._elimination(False)
     cands = np.array(elim.candidates(target, False), complex).reshape(-1, chain.n)
-    real = cands[np.all(np.abs(cands.imag) <= ik.CAND_TOL * (1 + np.abs(cands)), axis=1)]
-    return ik._refine(chain, ik._with_twins(chain, elim.angles(real)), T, 1e-9)[0]
+    real = cands[np.all(np.abs(cands.imag) <= elimination4.CAND_TOL * (1 + np.abs(cands)), axis=1)]
+    return poses.refine(chain, poses.with_twins(chain, elim.angles(real)), T, 1e-9)[0]
 
 
 def test_forward_elimination_alone_finds_every_generic_4a_pose():
@@ -309,9 +308,9 @@ def test_forward_elimination_alone_finds_every_generic_4a_pose():
         for q in rng.uniform(-np.pi, np.pi, (25, 4)):
             T = chain.fk(q)
             assert contains(forward_solutions(solver, chain, T), q, periods(chain)), (chain, q)
-            target = ik._study(T)
+            target = poses.study_point(T)
             target[4:] /= solver.scale
-            roots, _ = elim._resultant_roots(elim.image @ ik._left(target).T)
+            roots, _ = elim._resultant_roots(elim.image @ joints.left_matrix(target).T)
             u3 = np.tan((q[2] - elim.joints[2].delta) / 4)
             assert np.min(np.abs(roots - u3)) <= 1e-9 * (1 + abs(u3))
 
@@ -332,16 +331,16 @@ def test_quadric_without_yy_block():
     assert abs(np.sum(xy * Qx8)) < 1e-10 and abs(np.sum(xy * study)) < 1e-10
     assert elim.factors[0] == (2, 2) and elim.factors[-1] == (1, 1)
     T = chain.fk(np.array([0.3, -1.0, 2.0, 0.5]))
-    target = ik._study(T)
+    target = poses.study_point(T)
     target[4:] /= ik.Solver(chain).scale
-    C = elim.image @ ik._left(target).T
+    C = elim.image @ joints.left_matrix(target).T
     roots, pair = elim._resultant_roots(C)
     # deflated: the 48 roots of f against the yy-free image less its 8 spurious ones at u_3 = ±i
     # and the 8 where u_4 = ±i (the roots of f(·, ±i), there common to both)
     assert [p.shape for p in pair] == [(5, 5), (5, 5)] and len(roots) == 32
     f, *_, xy = elim._quadric_images(C, elim.factors)
     assert f.shape == (5, 5) and xy.shape == (7, 7)
-    full = ik._hidden_variable(f, xy, np.random.default_rng(0))
+    full = pencil.hidden_variable(f, xy, np.random.default_rng(0))
     at_i = np.abs(np.abs(full) - 1) + np.abs(full.real) < 1e-4
     fi = (1j ** np.arange(5)) @ f.T  # f(u, i) in u
     where_v_i = np.concatenate([np.roots(fi[::-1]), np.roots(fi[::-1]).conj()])
@@ -349,13 +348,11 @@ def test_quadric_without_yy_block():
     assert len(full) == 48 and np.count_nonzero(at_i) == 8 and np.count_nonzero(at_v_i) == 8
     rest = full[~(at_i | at_v_i)]
     assert np.all(np.abs(rest[:, None] - roots[None]).min(axis=1) <= 1e-6 * (1 + np.abs(rest)))
-    assert ik._deflated(xy, f) is None  # g's degree in v below f's
-    assert ik._deflated(f, xy + 1e-3 * np.random.default_rng(1).standard_normal(xy.shape)) is None  # no multiple
+    assert pencil.deflate(xy, f) is None  # g's degree in v below f's
+    assert pencil.deflate(f, xy + 1e-3 * np.random.default_rng(1).standard_normal(xy.shape)) is None  # no multiple
 
 
 def test_isotropic_factors_are_found_and_divided_exactly():
-    from apair import ik
-
     rng = np.random.default_rng(5)
     P = np.polynomial.polynomial
     q = rng.standard_normal((4, 6))
@@ -363,10 +360,10 @@ def test_isotropic_factors_are_found_and_divided_exactly():
     for _ in range(2):
         p = np.array([P.polymul(col, [1, 0, 1]) for col in p.T]).T  # (1 + u²)² ...
     p = np.array([P.polymul(row, [1, 0, 1]) for row in p])  # ... (1 + v²)
-    assert ik._isotropic_factors(p) == (2, 1)
-    assert np.allclose(ik._divided(p, (2, 1)), q, atol=1e-12)
+    assert pencil.isotropic_factors(p) == (2, 1)
+    assert np.allclose(pencil.isotropic_quotient(p, (2, 1)), q, atol=1e-12)
     p[0, 0] += 1e-6  # no longer divisible
-    assert ik._isotropic_factors(p) == (0, 0)
+    assert pencil.isotropic_factors(p) == (0, 0)
 
 
 def test_parallel_axes_give_a_regular_32_root_pencil():
@@ -382,9 +379,9 @@ def test_parallel_axes_give_a_regular_32_root_pencil():
     rng = np.random.default_rng(9)
     for q in rng.uniform(-np.pi, np.pi, (20, 4)):
         T = chain.fk(q)
-        target = ik._study(T)
+        target = poses.study_point(T)
         target[4:] /= solver.scale
-        roots, pair = elim._resultant_roots(elim.image @ ik._left(target).T)
+        roots, pair = elim._resultant_roots(elim.image @ joints.left_matrix(target).T)
         assert pair is not None and len(roots) == 32
         assert contains(forward_solutions(solver, chain, T), q, periods(chain))
 
@@ -392,7 +389,7 @@ def test_parallel_axes_give_a_regular_32_root_pencil():
 def compiled_ik():
     from apair import ik
 
-    if ik._native() is None:
+    if elimination4.native_in_use() is None:
         pytest.skip("the compiled C kernels are not installed")
     return ik
 
@@ -402,7 +399,7 @@ def test_compiled_4_joint_steps_agree_with_numpy(monkeypatch):
     by step, on random 4A and mixed designs, special ones and examples/4a_chain.toml (a 32-root
     pencil of two random combinations): the same eigenvalues, screened pairs and left halves."""
     ik = compiled_ik()
-    native = ik._native
+    native = elimination4.native_in_use
     rng = np.random.default_rng(21)
     generic = [random_chain(rng, 4), random_chain(rng, 4, "sr"), random_chain(rng, 4, "r")]
     chains = generic + [apair.load("examples/4a_chain.toml")] + [special_chain(rng, 4) for _ in range(4)]
@@ -412,17 +409,17 @@ def test_compiled_4_joint_steps_agree_with_numpy(monkeypatch):
         elim = solver._elimination(False)
         qs = [rng.uniform(-np.pi, np.pi, 4), special_angles(rng, 4)]
         for q in qs:
-            target = ik._study(chain.fk(q))
+            target = poses.study_point(chain.fk(q))
             target[4:] /= solver.scale
             if elim.pre is not None:
-                target = ik.multiply(elim.pre, ik.conjugate(target))
-            C = elim.image @ ik._left(target).T
+                target = multiply(elim.pre, conjugate(target))
+            C = elim.image @ joints.left_matrix(target).T
             steps = {}
             for engine in ("c", "numpy"):
-                monkeypatch.setattr(ik, "_native", native if engine == "c" else (lambda: None))
+                monkeypatch.setattr(elimination4, "native_in_use", native if engine == "c" else (lambda: None))
                 roots, pair = elim._resultant_roots(C)
                 u3 = np.sort_complex(roots)
-                real = u3[np.abs(u3.imag) <= ik.CAND_TOL * (1 + np.abs(u3))].real
+                real = u3[np.abs(u3.imag) <= elimination4.CAND_TOL * (1 + np.abs(u3))].real
                 screened = elim._screen(real, pair, C) if pair is not None else None
                 steps[engine] = u3, pair, screened
             (uc, pc, sc), (un, pn, sn) = steps["c"], steps["numpy"]
@@ -449,7 +446,7 @@ def test_compiled_4_joint_steps_agree_with_numpy(monkeypatch):
                 compared += 1
             lefts = {}  # the left half of the same images, every design
             for engine in ("c", "numpy"):
-                monkeypatch.setattr(ik, "_native", native if engine == "c" else (lambda: None))
+                monkeypatch.setattr(elimination4, "native_in_use", native if engine == "c" else (lambda: None))
                 lefts[engine] = elim._solve_left_many(sc[1])
             for a, b in zip(lefts["c"], lefts["numpy"]):
                 assert len(a) == len(b) and all(np.allclose(x, y, rtol=1e-7) for x, y in zip(a, b))
@@ -458,7 +455,7 @@ def test_compiled_4_joint_steps_agree_with_numpy(monkeypatch):
         # the screen's bounds, may differ with rounding: the common-roots path decides those)
         answers = {}
         for engine in ("c", "numpy"):
-            monkeypatch.setattr(ik, "_native", native if engine == "c" else (lambda: None))
+            monkeypatch.setattr(elimination4, "native_in_use", native if engine == "c" else (lambda: None))
             chain._ik = None
             answers[engine] = [chain.ik(chain.fk(q)) for q in qs]
         for a, b in zip(answers["c"], answers["numpy"]):  # as sets (twins at ±π may swap places)
@@ -479,12 +476,12 @@ def test_compiled_left_half_refuses_only_points_off_its_surface():
     x, y = rng.standard_normal((2, 20, 4))
     y -= np.sum(x * y, axis=1, keepdims=True) / np.sum(x * x, axis=1, keepdims=True) * x
     off = np.concatenate([x, y], 1)  # on the Study quadric, off the surface
-    status, *_ = ik._native().ik4_left(off, elim.Zmap, j2.P, joint, ik.LEFT_TOL)
+    status, *_ = elimination4.native_in_use().ik4_left(off, elim.Zmap, j2.P, joint, elimination4.LEFT_TOL)
     assert np.all(status == 2)
     assert all(len(s) == 0 for s in elim._solve_left_general(off))
     u = np.tan(rng.uniform(-1.4, 1.4, (20, 2)))
-    on = ik.multiply(ik._eval(elim.joints[0].A, u[:, 0]), ik._eval(elim.joints[1].A, u[:, 1]))
-    status, u1, u2, ok = ik._native().ik4_left(on, elim.Zmap, j2.P, joint, ik.LEFT_TOL)
+    on = multiply(joints.evaluate(elim.joints[0].A, u[:, 0]), joints.evaluate(elim.joints[1].A, u[:, 1]))
+    status, u1, u2, ok = elimination4.native_in_use().ik4_left(on, elim.Zmap, j2.P, joint, elimination4.LEFT_TOL)
     assert np.all(status == 0)
     assert np.allclose(u1, u[:, 0], rtol=1e-8)
     assert np.all(np.any(ok.astype(bool) & np.isclose(u2, u[:, 1:], rtol=1e-8), axis=1))

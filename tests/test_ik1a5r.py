@@ -1,4 +1,4 @@
-"""The elimination of six-joint chains with one A-pair (apair.ik1a5r, derivations/chain_ik1a5r.py):
+"""The elimination of six-joint chains with one A-pair (apair.ik.elimination1a5r, derivations/chain_ik1a5r.py):
 the generated equations at random poses against the DH product, the same solutions as the
 homotopy with the A-pair at every joint, roots far out, special designs, 5-joint chains through
 the virtual joint, unreachable poses, the fallback."""
@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 import apair
-from apair import homotopy, ik1a5r, kernels
+from apair import kernels
+from apair.ik import elimination1a5r as ik1a5r
+from apair.ik import homotopy
 
 PI = np.pi
 
@@ -222,11 +224,11 @@ def test_falls_back_to_the_homotopy_where_it_cannot_certify(monkeypatch):
 
 
 def test_column_divisions_remove_exactly_the_isotropic_factors():
-    """apair.matrixpoly on M(τ) = C(τ)·diag(1 + τ², 1 + τ², 1, 1)·S (C random, its first two
+    """apair.ik.pencil.Linearisation on M(τ) = C(τ)·diag(1 + τ², 1 + τ², 1, 1)·S (C random, its first two
     columns of degree 2, the others of degree 4; S a random constant mix): two factors found and
     divided out, the same other eigenvalues as the plain companion, and a polynomial without the
     factor left alone."""
-    from apair import matrixpoly
+    from apair.ik import pencil
 
     rng = np.random.default_rng(5)
     C = rng.standard_normal((5, 4, 4))
@@ -236,11 +238,11 @@ def test_column_divisions_remove_exactly_the_isotropic_factors():
     D += C
     D[2:, :, :2] += C[:3, :, :2]
     M = D @ S
-    lin = matrixpoly.Linearisation.of(M, 10)
+    lin = pencil.Linearisation.of(M, 10)
     assert lin.removed == 2 and lin.size == 4 * 4 - 4
-    plain = np.linalg.eigvals(matrixpoly.Linearisation.plain(4, 4).companion(M))
+    plain = np.linalg.eigvals(pencil.Linearisation.plain(4, 4).companion(M))
     deflated = np.linalg.eigvals(lin.companion(M))
     rest = plain[np.minimum(np.abs(plain - 1j), np.abs(plain + 1j)) > 1e-6]
     assert len(rest) == len(deflated) == 12
     assert max(np.min(np.abs(deflated - t)) for t in rest) < 1e-8
-    assert matrixpoly.Linearisation.of(C @ S, 10).removed == 0
+    assert pencil.Linearisation.of(C @ S, 10).removed == 0

@@ -1,4 +1,4 @@
-"""The 6R elimination (apair.ik6r, derivations/chain_ik6r.py): the derived equations at random 6R
+"""The 6R elimination (apair.ik.elimination6r, derivations/chain_ik6r.py): the derived equations at random 6R
 poses, the same 16 complex solutions as the homotopy on random and special designs, the chain read
 from its end, the fallback where it cannot certify, 5R chains through the virtual joint."""
 from __future__ import annotations
@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 import apair
-from apair import homotopy, ik6r
+from apair.ik import elimination6r as ik6r
+from apair.ik import homotopy
 from conftest import arm_toml
 
 PI = np.pi
@@ -106,7 +107,7 @@ def test_reversed_chain_reaches_the_inverse_pose():
     F = np.eye(4)
     for j in range(6):
         a, alpha, c, _ = dh_rev[j]
-        F = F @ homotopy._dh(-psi[5 - j], a, alpha, c, 0.0)
+        F = F @ homotopy.problem._dh(-psi[5 - j], a, alpha, c, 0.0)
     assert np.abs(F - T_rev).max() < 1e-12
 
 

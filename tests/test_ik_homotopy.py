@@ -1,5 +1,5 @@
-"""Inverse kinematics of 5- and 6-joint chains by parameter homotopy (apair.homotopy), the local
-solver (AChain.ik_local) and the solution counts (apair.ikcounts): round trips on random and
+"""Inverse kinematics of 5- and 6-joint chains by parameter homotopy (apair.ik.homotopy), the local
+solver (AChain.ik_local) and the solution counts (apair.ik.homotopy.counts): round trips on random and
 special designs, no false solutions, agreement with a dense multi-start search and with the
 eliminations of apair.ik, clear refusals."""
 from __future__ import annotations
@@ -11,8 +11,10 @@ import numpy as np
 import pytest
 
 import apair
-from apair import homotopy, ik1a5r, ikcounts
 from apair.cli import main as cli
+from apair.ik import elimination1a5r as ik1a5r
+from apair.ik import homotopy
+from apair.ik.homotopy import counts as ikcounts
 from conftest import arm_toml
 
 
@@ -32,7 +34,7 @@ def chain_of(pattern: str, rng, special: bool = False) -> apair.AChain:
 
 @pytest.fixture
 def tracked(monkeypatch):
-    """chain.ik by the homotopy also where a chain has one A-pair (apair.ik1a5r would answer)."""
+    """chain.ik by the homotopy also where a chain has one A-pair (apair.ik.elimination1a5r would answer)."""
     monkeypatch.setattr(ik1a5r, "applies", lambda problem: False)
 
 
@@ -190,12 +192,12 @@ def test_a_path_diverging_on_the_way_to_a_generic_pose_is_tracked_again(monkeypa
             s[:3] = homotopy.DIVERGED
         return e, s, steps, cond
 
-    monkeypatch.setattr(homotopy, "track", track)
+    monkeypatch.setattr(homotopy.tracker, "track", track)
     pa = homotopy.random_pose(np.random.default_rng(4))
-    _, status = homotopy._segment(problem, start.p0, pa, start.solutions, np.random.default_rng(5), finite=True)
+    _, status = homotopy.segment(problem, start.p0, pa, start.solutions, np.random.default_rng(5), finite=True)
     assert calls == [16, 3] and np.all(status == homotopy.OK)
     calls.clear()
-    _, status = homotopy._segment(problem, start.p0, pa, start.solutions, np.random.default_rng(5))
+    _, status = homotopy.segment(problem, start.p0, pa, start.solutions, np.random.default_rng(5))
     assert calls == [16] and np.sum(status == homotopy.DIVERGED) == 3  # toward a pose that need not be generic
 
 
@@ -291,13 +293,13 @@ def test_numpy_tracker_agrees_with_the_c_tracker():
 def test_far_out_solutions_are_refined_in_extended_precision():
     """Solutions far out in the complex (|Im θ| > 9) at a generic pose: with the residual in
     extended precision (ik_residual6_wide) the tracker's Newton refines each to the solution that
-    Newton at 50 digits (apair.trace's independent DH route) confirms, and none is left SINGULAR;
+    Newton at 50 digits (apair.ik.homotopy.trace's independent DH route) confirms, and none is left SINGULAR;
     with double residuals alone it stalls orders of magnitude farther away."""
     flint = pytest.importorskip("flint")
-    from apair import trace
+    from apair.ik.homotopy import trace
 
     problem = homotopy.Problem.of(ikcounts.design("AARRRR"))
-    p0, sols, _ = homotopy.monodromy(problem, np.random.default_rng(2))
+    p0, sols, _ = homotopy.monodromy.monodromy(problem, np.random.default_rng(2))
     far = sols[np.abs(sols.imag).max(axis=1) > 9]
     assert len(far) >= 5
 
@@ -467,11 +469,11 @@ def test_missing_solutions_are_found_by_chains_in_one_round(monkeypatch):
             gammas.append(gamma)
         return e, s, steps, cond
 
-    monkeypatch.setattr(homotopy, "track", track)
+    monkeypatch.setattr(homotopy.tracker, "track", track)
     ends = homotopy.solve(problem, start, T)
     assert len(gammas) == 2  # one retry round
     assert ends.failed == 0 and ends.complete == start.certified and len(ends.theta) == 48
-    index = homotopy._Index(problem)
+    index = homotopy.Index(problem)
     assert all(index.add(t) for t in truth.theta) and not any(index.add(t) for t in ends.theta)
 
 
@@ -481,7 +483,7 @@ def test_unrefined_endpoints_are_one_solution_within_loose():
     of an unrefined one."""
     problem = homotopy.Problem.of(ikcounts.design("AARRRR"))
     x = np.array([0.3 + 11j, -1.0, 2.0, 0.5, -0.2, 1.0 + 0.3j])
-    index = homotopy._Index(problem)
+    index = homotopy.Index(problem)
     assert index.place(x, loose=True) == (True, 0)
     assert index.place(x + 2e-3, loose=True) == (False, 0)
     assert index.place(x + 2e-3j) == (False, 0) and index.loose == [False]

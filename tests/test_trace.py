@@ -1,4 +1,4 @@
-"""The trace test (apair.trace): its extended-precision system against the generated kernel, the
+"""The trace test (apair.ik.homotopy.trace): its extended-precision system against the generated kernel, the
 augmented system's derivatives, and verdicts that can fail: a complete start set passes, a set
 short of one solution fails, a witness set short of its farthest point fails; special designs
 (a UR-like arm with 8 solutions) are certified; the verdict is cached and shown by the CLI."""
@@ -11,8 +11,10 @@ import numpy as np
 import pytest
 
 import apair
-from apair import homotopy, ikcounts, trace
 from apair.cli import main as cli
+from apair.ik import homotopy
+from apair.ik.homotopy import counts as ikcounts
+from apair.ik.homotopy import trace
 from conftest import arm_toml
 
 PI = np.pi
@@ -58,7 +60,7 @@ def test_slice_derivatives(times_lambda):
 def test_slice_tracker_c_matches_numpy():
     """apair_ik_track_slice and the NumPy tracker on the same slice paths: the same steps and
     endpoints (both modes: the trace family from the start set, a hyperplane move of its images)."""
-    if homotopy._native() is None:
+    if homotopy.tracker.native_in_use() is None:
         pytest.skip("the compiled C kernels are not installed")
     problem = homotopy.Problem.of(ikcounts.design("ARRARR"))
     start = homotopy.prepare(problem)
@@ -105,7 +107,7 @@ def test_missing_start_solutions_are_found():
     short = dataclasses.replace(start, solutions=start.solutions[3:])
     done = trace.certify(problem, short)
     assert done.count == 48 and done.certified and done.traced and done.runs[-1] == 48
-    index = homotopy._Index(problem)
+    index = homotopy.Index(problem)
     for x in done.solutions:
         index.add(x)
     assert not any(index.add(x) for x in start.solutions[:3])

@@ -4,6 +4,7 @@ The closed forms are derived symbolically (derivations/), emitted as C and NumPy
 (codegen/ -> generated/), and loaded here. See docs/conventions.md for frames and conventions.
 """
 from . import plots, polynomials  # plots imports matplotlib only when a picture is drawn
+from ._version import __version__
 from .chain import AChain
 from .io import load
 from .kernels import backend, c_available, set_backend
@@ -11,5 +12,4 @@ from .link import Link
 from .pair import APair
 from .simulate import Trajectory
 
-__version__ = "0.1.0"
 __all__ = ["APair", "AChain", "Link", "Trajectory", "load", "plots", "polynomials", "set_backend", "backend", "c_available", "__version__"]

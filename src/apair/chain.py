@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from . import _validate as V
+from .files import write_text
 from .kernels import call, native_chain
 from .link import Link
 from .pair import APair
@@ -274,13 +275,11 @@ class AChain:
 
     def specialise(self, kernels=None) -> "AChain":
         """This chain with its design built into its own kernels (`apair codegen`'s C, compiled
-        once into the cache, see apair.specialise.cache_root, and found again by content hash):
+        once into the cache, see apair.files.cache_root, and found again by content hash):
         the same methods, faster. `kernels`: a subset of fk, fk_study, jacobian, mass_matrix,
         coriolis, gravity_torques, bias, inverse_dynamics, forward_dynamics, energy (default: all;
         the others stay generic). Without a C compiler it warns once and uses the generic kernels
         (`.specialised` says which)."""
-        from .specialise import SpecialisedChain
-
         return SpecialisedChain(self, kernels)
 
     def to_mjcf(self, q=None, path=None, overwrite: bool = False, collisions: bool = False) -> str:
@@ -291,8 +290,6 @@ class AChain:
 
         xml = mjcf.to_mjcf(self, q, name=getattr(self, "name", None) or "apair chain", collisions=collisions)
         if path is not None:
-            from .plots import write_text
-
             write_text(path, xml, overwrite, ".xml")
         return xml
 
@@ -303,8 +300,6 @@ class AChain:
 
         html = view.to_html(self, workspace)
         if path is not None:
-            from .plots import write_text
-
             write_text(path, html, overwrite, ".html")
         return html
 
@@ -342,11 +337,13 @@ class AChain:
         |fk(q) − T| ≤ tol); (0, n) when T is out of reach. T: a 4×4 transform or a Study point.
         within_limits=True keeps only the solutions inside `limits` (no collisions).
 
-        Chains of 1 to 6 sinusoidal A-pairs or R-pairs. n ≤ 4 by kinematic mapping (see apair.ik):
-        the left half's constraint variety on the right part's image, eliminated to eigenvalue and
-        univariate problems. 5 and 6 R-pairs by the 6R elimination (apair.ik6r) where it certifies
-        its 16 solutions; otherwise n = 5, 6 by parameter homotopy (see apair.homotopy) from the
-        design's start system (`prepare_ik`, cached on disk), every complex solution tracked to T.
+        Chains of 1 to 6 sinusoidal A-pairs or R-pairs. n ≤ 4 by kinematic mapping (see
+        apair.ik.elimination4): the left half's constraint variety on the right part's image,
+        eliminated to eigenvalue and univariate problems. 5 and 6 R-pairs by the 6R elimination
+        (apair.ik.elimination6r) where it certifies its 16 solutions, chains with one A-pair by
+        theirs (apair.ik.elimination1a5r); otherwise n = 5, 6 by parameter homotopy (see
+        apair.ik.homotopy) from the design's start system (`prepare_ik`, cached on disk), every
+        complex solution tracked to T.
         Angles in (−2π, 2π] for A-pairs, (−π, π] for R-pairs.
         full=True returns an `apair.ik.Solution`: q, error, candidates, complex_count, `inside`
         (whether each solution is within `limits`) and `certified` (False where the elimination
@@ -370,18 +367,19 @@ class AChain:
     def prepare_ik(self, progress=None, refresh: bool = False, trace: bool = False):
         """n = 5, 6: the design's homotopy start system (every complex solution at a generic complex
         pose, by monodromy), from the cache or computed now and cached (`apair ik-prepare`).
-        trace: also run the trace test (apair.trace: seconds up to 48 solutions, minutes and maybe
-        no verdict for more, refused above 200), whose verdict is cached with the set and becomes
-        its `certified`.
-        Returns `apair.homotopy.StartSystem` (.count, .certified, .runs, .loops, .seconds, .trace)."""
-        from . import homotopy
+        trace: also run the trace test (apair.ik.homotopy.trace: seconds up to 48 solutions, minutes
+        and maybe no verdict for more, refused above 200), whose verdict is cached with the set and
+        becomes its `certified`.
+        Returns `apair.ik.homotopy.StartSystem` (.count, .certified, .runs, .loops, .seconds,
+        .trace)."""
+        from .ik import homotopy
 
         if self.n < 5:
             raise ValueError(f"chain: start systems are for 5 and 6 joints (this chain has {self.n}; its ik is "
                              "solved by elimination)")
         certify = None
         if trace:
-            from .trace import certify
+            from .ik.homotopy.trace import certify
         return homotopy.start_system(homotopy.Problem.of(self), progress=progress, refresh=refresh, certify=certify)
 
     def ik_local(self, T, q0, tol: float = 1e-10, max_iter: int = 100):
@@ -409,3 +407,35 @@ class AChain:
         q = self._q(q)
         lim = self.limits
         return np.all((q >= lim[:, 0]) & (q <= lim[:, 1]), axis=-1)
+
+
+class SpecialisedChain(AChain):
+    """An AChain whose kernel-backed methods (fk ... energy) run the chain's own specialised C
+    kernels (AChain.specialise, built by apair.specialise); everything else is the AChain's. Where
+    they cannot be had (no C compiler), the generic kernels serve, as said once in a warning."""
+
+    def __init__(self, chain: AChain, kernels=None):
+        from .specialise import check_kernels, content_hash
+
+        self.__dict__.update({k: v for k, v in chain.__dict__.items() if k not in ("_fast", "_call")})
+        self._kernels = check_kernels(kernels)
+        self.content_hash = content_hash(chain, self._kernels)
+        self._attach()
+
+    def _attach(self) -> None:
+        """The specialised fast path (building it on first use; the references of its self-test
+        come from the generic kernels, which serve until then)."""
+        from .specialise import load
+
+        self._use(self._native_chain())
+        fast = load(self, METHODS, self._kernels)
+        self.specialised = fast is not None
+        if fast is not None:
+            self._use(fast)
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._attach()
+
+    def __repr__(self) -> str:
+        return f"{super().__repr__()}.specialise()"

@@ -8,7 +8,8 @@ import sys
 
 import numpy as np
 
-from . import __version__, polynomials
+from . import polynomials
+from ._version import __version__
 from .io import load
 from .kernels import backend, manifest
 
@@ -31,15 +32,15 @@ def _cmd_show(args) -> int:
 
 
 def _show_ik_counts(args) -> int:
-    from . import homotopy
+    from .ik.homotopy import stored_counts
 
-    rows = homotopy.stored_counts()
+    rows = stored_counts()
     if args.json:
         print(json.dumps(rows, indent=1))
         return 0
     print("Generic number of complex inverse-kinematics solutions of R/A chains (A: sinusoidal A-pair,\n"
           "R: R-pair; a pattern and its reverse have the same count). n < 6: at a pose of the chain's own\n"
-          "image. Computed by apair.ikcounts (make ik-counts) with the homotopy machinery of chain.ik;\n"
+          "image. Computed by apair.ik.homotopy.counts (make ik-counts) with the homotopy machinery of chain.ik;\n"
           "'how' lists the start set's monodromy runs (for n < 6 the 6-joint set with virtual joints);\n"
           "certified: by the trace test where 'how' names one, else two runs found the count and a run\n"
           "on a second design found no more (weaker).\n"
@@ -52,7 +53,7 @@ def _show_ik_counts(args) -> int:
 
 
 def _cmd_ik_prepare(args) -> int:
-    from .trace import MAX_SOLUTIONS
+    from .ik.homotopy.trace import MAX_SOLUTIONS
 
     chain = load(args.file)
     if chain.n < 5:
@@ -202,9 +203,9 @@ def _cmd_workspace(args) -> int:
 
     chain = load(args.file)
     if args.plot:
-        from .plots import _target
+        from .files import target
 
-        _target(args.plot, args.force)  # refuse before the long run, not after it
+        target(args.plot, args.force)  # refuse before the long run, not after it
     ws = chain.workspace(samples=args.samples, resolution=args.resolution, engine=args.scheduler,
                          progress=text_progress() if not args.quiet else None)
     print(f"{chain.name}: workspace {ws.summary} from {len(ws.points)} samples; voxel {ws.voxel:.3g} m, "
@@ -221,7 +222,7 @@ def _cmd_export(args) -> int:
     chain = load(args.file)
     q = None if args.q is None else _parse_angles(args.q.split(","), args.deg)
     from . import mjcf
-    from .plots import write_text
+    from .files import write_text
 
     xml = mjcf.to_mjcf(chain, q, name=chain.name or os.path.basename(args.file), collisions=args.collisions)
     out = write_text(args.out, xml, args.force, ".xml")
@@ -260,9 +261,12 @@ def _cmd_codegen(args) -> int:
     name = specialise.check_prefix(args.prefix) if args.prefix else specialise.prefix_from(args.file)
     kernels = None if args.kernels is None else [k.strip() for k in args.kernels.split(",") if k.strip()]
     changed = specialise.write_code(chain, args.out, name, os.path.basename(args.file), kernels,
-                                    title=chain.name)
-    print(f"apair codegen: {name} ({chain.n} joints) in {args.out}: {len(changed)} files written or changed "
-          f"({time.perf_counter() - t0:.1f} s)")
+                                    title=chain.name, force=args.force)
+    notes = [c for c in changed if c.startswith("kept ")]
+    print(f"apair codegen: {name} ({chain.n} joints) in {args.out}: {len(changed) - len(notes)} files written, "
+          f"changed or removed ({time.perf_counter() - t0:.1f} s)")
+    for note in notes:
+        print(f"  {note}")
     return 0
 
 
@@ -330,6 +334,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--kernels", metavar="LIST",
                    help="comma-separated subset of fk, fk_study, jacobian, mass_matrix, coriolis, gravity_torques, "
                    "bias, inverse_dynamics, forward_dynamics, energy (default: all)")
+    p.add_argument("--force", action="store_true",
+                   help="replace files in --out that an earlier apair codegen did not write (never through a link)")
     p.set_defaults(func=_cmd_codegen)
     p = sub.add_parser("export", help="the chain in another tool's format: mjcf (a MuJoCo model)",
                        description="Write a MuJoCo model (MJCF) of the chain's mechanism: every A-pair as its "

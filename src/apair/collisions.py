@@ -185,13 +185,12 @@ def _rational(x: float) -> Fraction:
 
 
 def unit_pair(pair):
-    """The same pair in units of its size r_b + r_p (collision angles do not depend on scale)."""
-    from .pair import APair
-
+    """The same pair (an APair, made by its own class) in units of its size r_b + r_p (collision
+    angles do not depend on scale)."""
     s = pair.base_radius + pair.platform_radius
     L1 = None if pair.kind == "sinusoidal" else pair.leg_lengths[0] / s
-    return APair(pair.base_radius / s, pair.platform_radius / s, leg_length=L1, leg_radius=pair.leg_radius / s,
-                 thickness=pair.thickness / s)
+    return type(pair)(pair.base_radius / s, pair.platform_radius / s, leg_length=L1, leg_radius=pair.leg_radius / s,
+                      thickness=pair.thickness / s)
 
 
 def limits(pair) -> CollisionLimits:

@@ -48,6 +48,18 @@ def c_available() -> bool:
     return _native()[0] is not None
 
 
+def native_module():
+    """(apair._native, None) where the compiled C kernels are installed, else (None, why not): for
+    the code that calls the extension's own functions whatever the backend (AChain.ik_local)."""
+    return _native()
+
+
+def native_in_use():
+    """apair._native where the C backend is in use, else None: the inverse kinematics' C steps,
+    each with a NumPy twin that serves where this is None."""
+    return _native()[0] if backend() == "c" else None
+
+
 def set_backend(name: str | None) -> None:
     """Choose "c" or "numpy" for every later kernel call (None: the default, which reads
     APAIR_BACKEND again and otherwise takes C when present)."""

@@ -11,13 +11,12 @@ from __future__ import annotations
 import hashlib
 import keyword
 import re
-from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
-from .chain import AChain
+from .files import cache_root, toolkit_digest
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _C_KEYWORDS = frozenset(
@@ -45,23 +44,6 @@ def design_of(chain):
         links=tuple(tuple(float(x) for x in row) for row in chain._links),
         legs=tuple(tuple(float(x) for x in row) for row in chain._legs),
         gravity=tuple(float(x) for x in chain.gravity))
-
-
-@lru_cache(maxsize=None)
-def toolkit_digest() -> str:
-    """SHA-256 of what turns a design into code: the derivations, the code generator with its
-    templates, apair's and sympy's versions (sympy's printing and evaluation shape the output)."""
-    import sympy
-
-    from . import __version__
-
-    h = hashlib.sha256(f"apair {__version__} sympy {sympy.__version__}\0".encode())
-    for package in ("derivations", "codegen"):
-        root = Path(str(resources.files(f"apair.{package}")))
-        for path in sorted(root.rglob("*")):
-            if path.is_file() and path.suffix in (".py", ".j2", ".c", ".h") and "__pycache__" not in path.parts:
-                h.update(f"{package}/{path.relative_to(root).as_posix()}\0".encode() + path.read_bytes() + b"\0")
-    return h.hexdigest()
 
 
 def content_hash(chain, kernels) -> str:
@@ -164,30 +146,22 @@ def render(chain, name: str, origin: str, kernels=None, title: str | None = None
     return emitter.Emitter().render_chain(code, parts, name, meta, [dict(t, kernel=by_name[t["name"]]) for t in tests])
 
 
-def write_code(chain, out, name: str, origin: str, kernels=None, title: str | None = None) -> list[str]:
-    """Write the chain's code into the folder `out` (created if need be; a non-empty folder is
-    refused unless an earlier run of this wrote it). Returns the files changed."""
+def write_code(chain, out, name: str, origin: str, kernels=None, title: str | None = None,
+               force: bool = False) -> list[str]:
+    """Write the chain's code into the folder `out` (created if need be). A file there that an
+    earlier run did not write (a user's own, a symbolic link) is refused unless `force`; stale
+    files of an earlier run are removed only while unedited (codegen/output.py). Returns the
+    changes."""
     _, emitter = _toolkit()
     files = render(chain, name, origin, kernels, title)
     try:
-        return emitter.write(files, Path(out))
+        return emitter.write(files, Path(out), force=force)
     except emitter.OutputError as exc:
         raise ValueError(str(exc)) from None
 
 
 # ------------------------------------------------------------------------------------ AChain.specialise
 _warned = set()
-
-
-def cache_root() -> Path:
-    """Where compiled specialised chains are kept: $APAIR_CACHE, else $XDG_CACHE_HOME/apair, else
-    ~/.cache/apair."""
-    import os
-
-    if os.environ.get("APAIR_CACHE"):
-        return Path(os.environ["APAIR_CACHE"])
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "apair"
 
 
 def _compiler() -> str | None:
@@ -253,12 +227,12 @@ def build(chain, kernels=None) -> tuple[Path, str, tuple[str, ...]] | None:
     return library, name, kernels
 
 
-def load(chain, kernels=None):
-    """The native fast path of the chain's specialised kernels (kernels.native_chain) and the
-    loaded library, or None (no compiler, or the C backend is not installed)."""
+def load(chain, methods, kernels=None):
+    """The native fast path of the chain's specialised kernels (kernels.native_chain) for the
+    chain's `methods` ((kernel family, strict) in the order of its fast path: apair.chain.METHODS)
+    and the loaded library, or None (no compiler, or the C backend is not installed)."""
     import ctypes
 
-    from . import chain as _chain
     from . import kernels as _kernels
 
     if not _kernels.c_available():
@@ -276,35 +250,8 @@ def load(chain, kernels=None):
     base = ctypes.addressof(ctypes.c_char.in_dll(lib, f"{name}_registry"))
     families = {f: k for k, f in _toolkit()[0].KERNELS.items()}
     fast = _kernels.native_chain(
-        chain.n, [(families.get(family, family), strict) for family, strict in _chain.METHODS], [],
+        chain.n, [(families.get(family, family), strict) for family, strict in methods], [],
         [p.theta_limit if p.theta_limit is not None else float("inf") for p in chain.pairs], {}, keep=lib,
         table=(base, names))
     return fast
 
-
-class SpecialisedChain(AChain):
-    """An AChain whose kernel-backed methods (fk ... energy) run the chain's own specialised C
-    kernels (AChain.specialise); everything else is the AChain's. Where they cannot be had (no
-    C compiler), the generic kernels serve, as said once in a warning."""
-
-    def __init__(self, chain: AChain, kernels=None):
-        self.__dict__.update({k: v for k, v in chain.__dict__.items() if k not in ("_fast", "_call")})
-        self._kernels = check_kernels(kernels)
-        self.content_hash = content_hash(chain, self._kernels)
-        self._attach()
-
-    def _attach(self) -> None:
-        """The specialised fast path (building it on first use; the references of its self-test
-        come from the generic kernels, which serve until then)."""
-        self._use(self._native_chain())
-        fast = load(self, self._kernels)
-        self.specialised = fast is not None
-        if fast is not None:
-            self._use(fast)
-
-    def __setstate__(self, state):
-        self.__dict__.update(state)
-        self._attach()
-
-    def __repr__(self) -> str:
-        return f"{super().__repr__()}.specialise()"

@@ -85,7 +85,8 @@ def from_matrix(T) -> np.ndarray:
     return np.concatenate([x, y], -1)
 
 
-def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product of quaternions (..., 4), broadcasting (object arrays too)."""
     a0, a1, a2, a3 = np.moveaxis(a, -1, 0)
     b0, b1, b2, b3 = np.moveaxis(b, -1, 0)
     return np.stack([a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
@@ -98,8 +99,8 @@ def multiply(p, q) -> np.ndarray:
     """Dual-quaternion product of (..., 8) Study points (broadcasting; real or complex):
     (x1 + εy1)(x2 + εy2) = x1x2 + ε(x1y2 + y1x2), the point of T1·T2."""
     p, q = np.asarray(p), np.asarray(q)
-    return np.concatenate([_qmul(p[..., :4], q[..., :4]),
-                           _qmul(p[..., :4], q[..., 4:]) + _qmul(p[..., 4:], q[..., :4])], -1)
+    return np.concatenate([qmul(p[..., :4], q[..., :4]),
+                           qmul(p[..., :4], q[..., 4:]) + qmul(p[..., 4:], q[..., :4])], -1)
 
 
 _CONJ = np.array([1.0, -1.0, -1.0, -1.0, 1.0, -1.0, -1.0, -1.0])

@@ -16,6 +16,7 @@ from importlib import resources
 import numpy as np
 
 from . import collisions
+from .files import write_text
 
 CLEARANCE_STEP = np.radians(0.25)  # the clearance table's spacing in θ
 
@@ -77,6 +78,4 @@ def to_html(chain, workspace: int = 0) -> str:
 def write(chain, path, overwrite: bool = False, workspace: int = 0):
     """Writes the page to path (.html added if it has no suffix); an existing file only with
     overwrite=True. Returns the path."""
-    from .plots import write_text
-
     return write_text(path, to_html(chain, workspace), overwrite, ".html")

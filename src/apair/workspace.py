@@ -29,6 +29,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import figures
+
 LEVELS = (1.0, 1.25, 1.5, 1.75, 2.0)  # voxel sizes in units of h₀
 OFFSETS = 3  # random grid offsets per voxel size
 BATCH = 50_000
@@ -76,9 +78,7 @@ class Workspace:
 
     def plot(self, path, overwrite: bool = False):
         """A 3D view of the points and three cross-sections through the centre (matplotlib)."""
-        from .plots import workspace
-
-        return workspace(self, path, overwrite=overwrite)
+        return figures.workspace(self, path, overwrite=overwrite)
 
 
 def _batch(chain, q_lo, q_hi, seed, count, centres, sigma, poses):

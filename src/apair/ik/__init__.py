@@ -1,0 +1,22 @@
+"""Inverse kinematics of A-chains (`AChain.ik`, `AChain.ik_local`, `AChain.prepare_ik`): every real
+solution of a pose, each verified, by the cheapest exact method that fits the chain.
+
+- `solver`: the front (`Solver`, `Solution`), which picks the method by the chain's shape;
+- `elimination4`: 1 to 4 joints by kinematic mapping (the joints as curves in the Study algebra in
+  `joints`, the polynomial and pencil algebra in `pencil`);
+- `elimination6r`, `elimination1a5r`: six joints (and five, with a virtual joint), all R-pairs or
+  one A-pair, by the Raghavan-Roth elimination;
+- `homotopy`: every complex solution of 5 and 6 joints by parameter homotopy from the design's
+  start system (tracker, monodromy, start sets, the trace test, the patterns' counts);
+- `poses`: poses in and the verification of candidates; `local`: Levenberg-Marquardt searches
+  (the fallback, the nearest reachable pose `distance`, and `ik_local` in C).
+
+Nothing here imports `apair.chain` (the chain delegates to this package, never the other way)
+but the `make ik-counts` script `homotopy.counts`, which draws a random chain of every pattern.
+"""
+from __future__ import annotations
+
+from .local import LocalSolution, distance, ik_local
+from .solver import Solution, Solver
+
+__all__ = ["LocalSolution", "Solution", "Solver", "distance", "ik_local"]
