@@ -10,6 +10,7 @@ Flags: ISO C (-std=c11, so no floating-point contraction: the results match the 
 rounding) and -fno-math-errno (libm need not set errno, which lets the compiler fuse sin and cos
 of one angle into sincos; results are unchanged).
 """
+
 import hashlib
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -40,10 +41,20 @@ class BuildExt(build_ext):
         of one extension one after the other."""
         cc = self.compiler
         if all(hasattr(cc, f) for f in ("_setup_compile", "_get_cc_args", "_compile")):
-            def compile_parallel(sources, output_dir=None, macros=None, include_dirs=None, debug=0,
-                                 extra_preargs=None, extra_postargs=None, depends=None):
+
+            def compile_parallel(
+                sources,
+                output_dir=None,
+                macros=None,
+                include_dirs=None,
+                debug=0,
+                extra_preargs=None,
+                extra_postargs=None,
+                depends=None,
+            ):
                 macros, objects, extra, pp_opts, build = cc._setup_compile(
-                    output_dir, macros, include_dirs, sources, depends, extra_postargs)
+                    output_dir, macros, include_dirs, sources, depends, extra_postargs
+                )
                 cc_args = cc._get_cc_args(pp_opts, debug, extra_preargs)
                 todo = [obj for obj in objects if obj in build]
                 with ThreadPoolExecutor(os.cpu_count() or 1) as pool:
@@ -55,8 +66,9 @@ class BuildExt(build_ext):
 
     def run(self):
         if os.environ.get("APAIR_NO_C"):
-            print("apair: APAIR_NO_C is set, installing without the compiled C kernels (the NumPy kernels "
-                  "will be used)")
+            print(
+                "apair: APAIR_NO_C is set, installing without the compiled C kernels (the NumPy kernels will be used)"
+            )
             self.extensions = []
             return
         try:
@@ -65,7 +77,8 @@ class BuildExt(build_ext):
             raise SystemExit(
                 f"apair: the C kernels could not be compiled ({type(exc).__name__}: {exc}). Install a C "
                 "compiler (e.g. apt install gcc) and retry, or set APAIR_NO_C=1 to install without them "
-                "(the runtime then uses the slower NumPy kernels).") from None
+                "(the runtime then uses the slower NumPy kernels)."
+            ) from None
 
 
 setup(
@@ -80,5 +93,5 @@ setup(
             libraries=["m"],
             define_macros=[("APAIR_SOURCES_HASH", f'"{sources_hash(C_FILES)}"')],
         )
-    ]
+    ],
 )

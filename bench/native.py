@@ -7,6 +7,7 @@ as JSON; it also writes its results for the first poses so that agreement is che
 timing is reported (each program first runs one untimed warm-up round). apair's path is the one a C user takes: each joint's law kernel (one sincos
 per joint), then the chain kernel's batch function with the design shared by the batch.
 """
+
 from __future__ import annotations
 
 import json
@@ -53,13 +54,22 @@ def write_inputs(path: Path, chain, states: States) -> None:
     """count, n, then q, qd, qdd, tau, dh, links, legs, gravity, law parameters (n) as doubles."""
     law_param = np.array([p.law_kernel[1][0] if p.law_kernel[1] else 0.0 for p in chain.pairs])
     head = np.array([states.count, states.n], dtype=np.float64)
-    parts = [head, states.q, states.qd, states.qdd, states.tau, chain._dh, chain._links, chain._legs, chain.gravity,
-             law_param]
+    parts = [
+        head,
+        states.q,
+        states.qd,
+        states.qdd,
+        states.tau,
+        chain._dh,
+        chain._links,
+        chain._legs,
+        chain.gravity,
+        law_param,
+    ]
     np.concatenate([np.ascontiguousarray(p, dtype=np.float64).ravel() for p in parts]).tofile(path)
 
 
 PEERS = ROOT / "bench" / "peers"  # bench_inputs.h: the input file's reader, shared by every program
-
 
 
 def apair_program(chain) -> str:
@@ -79,11 +89,13 @@ def apair_program(chain) -> str:
         for name in extra:
             call_inputs.append(f"{name.upper()}, {n}")
         design = {"fk": ["DH, 0"], "jacobian": ["DH, 0"], "mass_matrix": ["DH, 0", "LINKS, 0", "LEGS, 0"]}.get(
-            op, ["DH, 0", "LINKS, 0", "LEGS, 0", "GRAV, 0"])
-        ops_code.append((op, f"apair_{stem}{n}_batch((size_t)COUNT, {', '.join(call_inputs + design)}, OUT_{op});",
-                         size(n)))
+            op, ["DH, 0", "LINKS, 0", "LEGS, 0", "GRAV, 0"]
+        )
+        ops_code.append(
+            (op, f"apair_{stem}{n}_batch((size_t)COUNT, {', '.join(call_inputs + design)}, OUT_{op});", size(n))
+        )
     body = []
-    for op, call, size in ops_code:
+    for _op, call, _size in ops_code:
         body.append(f"""
         t0 = now_ns();
         laws_all();
@@ -94,8 +106,9 @@ def apair_program(chain) -> str:
     outs = "\n".join(f"static double *OUT_{op};" for op in names)
     allocs = "\n    ".join(f"OUT_{op} = (double *)malloc(sizeof(double) * COUNT * {size});" for op, _, size in ops_code)
     dumps = "\n    ".join(f"fwrite(OUT_{op}, sizeof(double), {CHECKED} * {size}, f);" for op, _, size in ops_code)
-    prints = " ".join(f'printf("%s\\"{op}\\": %.3f", "{"{" if k == 0 else ", "}", best[{k}]);'
-                      for k, op in enumerate(names))
+    prints = " ".join(
+        f'printf("%s\\"{op}\\": %.3f", "{"{" if k == 0 else ", "}", best[{k}]);' for k, op in enumerate(names)
+    )
     return f"""#define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdio.h>
@@ -138,7 +151,7 @@ int main(int argc, char **argv)
     LAW = (double *)malloc(sizeof(double) * COUNT * {5 * n});
     {allocs}
     for (k = 0; k < {len(names) + 2}; ++k) best[k] = 1e300;
-    for (round = 0; round <= atoi(argv[3]); ++round) {{{''.join(body)}
+    for (round = 0; round <= atoi(argv[3]); ++round) {{{"".join(body)}
         t0 = now_ns();
         sink += trig_only();
         t = (now_ns() - t0) / COUNT;
@@ -165,7 +178,7 @@ def specialised_program(n: int) -> str:
     """C source timing the chain's specialised kernels (apair codegen): they take q (and qd, qdd
     or tau) only, the design is built in."""
     body, names = [], list(OPERATIONS)
-    for k, (op, (stem, extra, size)) in enumerate(OPERATIONS.items()):
+    for k, (op, (_stem, extra, _size)) in enumerate(OPERATIONS.items()):
         args = ", ".join(["Q"] + [x.upper() for x in extra])
         body.append(f"""
         t0 = now_ns();
@@ -173,11 +186,13 @@ def specialised_program(n: int) -> str:
         t = (now_ns() - t0) / COUNT;
         if (round > 0 && t < best[{k}]) best[{k}] = t;""")
     outs = "\n".join(f"static double *OUT_{op};" for op in names)
-    allocs = "\n    ".join(f"OUT_{op} = (double *)malloc(sizeof(double) * COUNT * {OPERATIONS[op][2](n)});"
-                          for op in names)
+    allocs = "\n    ".join(
+        f"OUT_{op} = (double *)malloc(sizeof(double) * COUNT * {OPERATIONS[op][2](n)});" for op in names
+    )
     dumps = "\n    ".join(f"fwrite(OUT_{op}, sizeof(double), {CHECKED} * {OPERATIONS[op][2](n)}, f);" for op in names)
-    prints = " ".join(f'printf("%s\\"{op}\\": %.3f", "{"{" if k == 0 else ", "}", best[{k}]);'
-                      for k, op in enumerate(names))
+    prints = " ".join(
+        f'printf("%s\\"{op}\\": %.3f", "{"{" if k == 0 else ", "}", best[{k}]);' for k, op in enumerate(names)
+    )
     return f"""#define _POSIX_C_SOURCE 199309L
 #include <stdio.h>
 #include <stdlib.h>
@@ -195,7 +210,7 @@ int main(int argc, char **argv)
     if (argc < 4 || read_inputs(argv[1])) return 2;
     {allocs}
     for (k = 0; k < {len(names)}; ++k) best[k] = 1e300;
-    for (round = 0; round <= atoi(argv[3]); ++round) {{{''.join(body)}
+    for (round = 0; round <= atoi(argv[3]); ++round) {{{"".join(body)}
     }}
     f = fopen(argv[2], "wb");
     {dumps}
@@ -217,8 +232,11 @@ def specialised_build(chain, workdir: Path, opt: str) -> Path:
         specialise.write_code(chain, code, SPECIALISED, "the bench chain", kernels)
     exe = workdir / f"specialised{chain.n}{opt}"
     source = specialised_program(chain.n)
-    return cached(exe, [source, (code / f"{SPECIALISED}.c").read_text(), opt],
-                  lambda: compile_c(source, exe, [opt, f"-I{code}", f"-I{PEERS}"], [str(code / f"{SPECIALISED}.c"), "-lm"]))
+    return cached(
+        exe,
+        [source, (code / f"{SPECIALISED}.c").read_text(), opt],
+        lambda: compile_c(source, exe, [opt, f"-I{code}", f"-I{PEERS}"], [str(code / f"{SPECIALISED}.c"), "-lm"]),
+    )
 
 
 def pinned(cmd: list[str]) -> list[str]:
@@ -250,8 +268,9 @@ def cached(exe: Path, key: list[str], build) -> Path:
 
 
 def run_program(exe: Path, inputs: Path, outputs: Path, rounds: int) -> dict:
-    res = subprocess.run(pinned([str(exe), str(inputs), str(outputs), str(rounds)]), check=True, capture_output=True,
-                         text=True)
+    res = subprocess.run(
+        pinned([str(exe), str(inputs), str(outputs), str(rounds)]), check=True, capture_output=True, text=True
+    )
     return json.loads(res.stdout)
 
 
@@ -262,7 +281,9 @@ def apair_build(chain, workdir: Path, opt: str) -> Path:
     kernels = [f"{stem}{n}" for stem, _, _ in OPERATIONS.values()]
     kernels += sorted({p.law_kernel[0] for p in chain.pairs})
     exe = workdir / f"apair{n}_{'_'.join(sorted({p.law_kernel[0][4:] for p in chain.pairs}))}{opt}"
-    compile_c(apair_program(chain), exe, [opt, f"-I{c_dir}", f"-I{PEERS}"], [str(c_dir / f"{k}.c") for k in kernels] + ["-lm"])
+    compile_c(
+        apair_program(chain), exe, [opt, f"-I{c_dir}", f"-I{PEERS}"], [str(c_dir / f"{k}.c") for k in kernels] + ["-lm"]
+    )
     return exe
 
 
@@ -271,7 +292,7 @@ def read_outputs(path: Path, n: int) -> dict:
     out, pos = {}, 0
     for op, (_, _, size) in OPERATIONS.items():
         k = CHECKED * size(n)
-        out[op] = data[pos:pos + k].reshape(CHECKED, -1)
+        out[op] = data[pos : pos + k].reshape(CHECKED, -1)
         pos += k
     return out
 
@@ -288,8 +309,12 @@ def cmeel_prefix() -> Path | None:
     return None
 
 
-BOOST_DEFINES = ["-DBOOST_MPL_LIMIT_LIST_SIZE=30", "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
-                 "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS", "-DBOOST_FUSION_INVOKE_MAX_ARITY=12"]
+BOOST_DEFINES = [
+    "-DBOOST_MPL_LIMIT_LIST_SIZE=30",
+    "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
+    "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS",
+    "-DBOOST_FUSION_INVOKE_MAX_ARITY=12",
+]
 
 
 def pinocchio_build(workdir: Path, opt: str) -> Path:
@@ -301,8 +326,19 @@ def pinocchio_build(workdir: Path, opt: str) -> Path:
     source = PEERS / "pinocchio_timing.cpp"
     # Pinocchio's own compile definitions for Boost (its CMake config), but not its
     # PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION: the algorithms are compiled here, with these flags
-    cmd = ["g++", "-std=c++17", opt, "-DNDEBUG", *BOOST_DEFINES, f"-I{prefix / 'include'}",
-           f"-I{prefix / 'include' / 'eigen3'}", f"-I{PEERS}", str(source), "-o", str(exe)]
+    cmd = [
+        "g++",
+        "-std=c++17",
+        opt,
+        "-DNDEBUG",
+        *BOOST_DEFINES,
+        f"-I{prefix / 'include'}",
+        f"-I{prefix / 'include' / 'eigen3'}",
+        f"-I{PEERS}",
+        str(source),
+        "-o",
+        str(exe),
+    ]
     key = cmd + [source.read_text(), (PEERS / "bench_inputs.h").read_text(), str(prefix)]
     return cached(exe, key, lambda: subprocess.run(cmd, check=True))
 
@@ -328,12 +364,30 @@ def casadi_generate(workdir: Path, inputs: Path) -> Path:
     include, lib = dirs
     exe = workdir / "casadi_codegen"
     source = PEERS / "casadi_codegen.cpp"
-    cmd = ["g++", "-std=c++17", "-O1", *BOOST_DEFINES, f"-I{prefix / 'include'}", f"-I{prefix / 'include' / 'eigen3'}",
-           f"-I{include}", f"-I{PEERS}", str(source), f"-L{lib}", "-lcasadi", f"-Wl,-rpath,{lib}", "-o", str(exe)]
-    cached(exe, cmd + [source.read_text(), (PEERS / "bench_inputs.h").read_text()], lambda: subprocess.run(cmd, check=True))
+    cmd = [
+        "g++",
+        "-std=c++17",
+        "-O1",
+        *BOOST_DEFINES,
+        f"-I{prefix / 'include'}",
+        f"-I{prefix / 'include' / 'eigen3'}",
+        f"-I{include}",
+        f"-I{PEERS}",
+        str(source),
+        f"-L{lib}",
+        "-lcasadi",
+        f"-Wl,-rpath,{lib}",
+        "-o",
+        str(exe),
+    ]
+    cached(
+        exe, cmd + [source.read_text(), (PEERS / "bench_inputs.h").read_text()], lambda: subprocess.run(cmd, check=True)
+    )
     out = workdir / f"casadi_c_{inputs.stem}"
     out.mkdir(exist_ok=True)
-    res = subprocess.run([str(exe), str(inputs.resolve()), str(out)], check=True, cwd=out, capture_output=True, text=True)
+    res = subprocess.run(
+        [str(exe), str(inputs.resolve()), str(out)], check=True, cwd=out, capture_output=True, text=True
+    )
     (out / "ops.json").write_text(res.stdout)
     return out
 
@@ -341,9 +395,13 @@ def casadi_generate(workdir: Path, inputs: Path) -> Path:
 def casadi_program(n: int, prefix: str) -> str:
     """C source timing CasADi's generated functions `{prefix}<op>` over the poses, one call per pose."""
     design = prefix == "pind_"
-    specs = {"fk": ("Q", [], ["DH"]), "jacobian": ("Q", [], ["DH"]), "mass_matrix": ("Q", [], ["DH", "LINKS"]),
-             "inverse_dynamics": ("Q", ["QD", "QDD"], ["DH", "LINKS", "GRAV"]),
-             "forward_dynamics": ("Q", ["QD", "TAU"], ["DH", "LINKS", "GRAV"])}
+    specs = {
+        "fk": ("Q", [], ["DH"]),
+        "jacobian": ("Q", [], ["DH"]),
+        "mass_matrix": ("Q", [], ["DH", "LINKS"]),
+        "inverse_dynamics": ("Q", ["QD", "QDD"], ["DH", "LINKS", "GRAV"]),
+        "forward_dynamics": ("Q", ["QD", "TAU"], ["DH", "LINKS", "GRAV"]),
+    }
     blocks, outs, allocs, dumps = [], [], [], []
     for k, (op, (q, state, des)) in enumerate(specs.items()):
         size = OPERATIONS[op][2](n)
@@ -372,14 +430,16 @@ def casadi_program(n: int, prefix: str) -> str:
             t = (now_ns() - t0) / COUNT;
             if (round > 0 && t < best[{k}]) best[{k}] = t;
         }}""")
-    prints = " ".join(f'printf("%s\\"{op}\\": %.3f", "{"{" if k == 0 else ", "}", best[{k}]);' for k, op in enumerate(specs))
+    prints = " ".join(
+        f'printf("%s\\"{op}\\": %.3f", "{"{" if k == 0 else ", "}", best[{k}]);' for k, op in enumerate(specs)
+    )
     return f"""#define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
 
-#include "{'pin_design.h' if design else 'pin_baked.h'}"
+#include "{"pin_design.h" if design else "pin_baked.h"}"
 #include "bench_inputs.h"
 
 {chr(10).join(outs)}
@@ -391,7 +451,7 @@ int main(int argc, char **argv)
     FILE *f;
     if (argc < 4 || read_inputs(argv[1])) return 2;
     {chr(10).join("    " + a for a in allocs).strip()}
-    for (round = 0; round <= atoi(argv[3]); ++round) {{{''.join(blocks)}
+    for (round = 0; round <= atoi(argv[3]); ++round) {{{"".join(blocks)}
     }}
     f = fopen(argv[2], "wb");
     {chr(10).join("    " + d for d in dumps).strip()}
@@ -419,8 +479,9 @@ def _agreement(ref: dict, got: dict) -> dict:
     return {op: float(np.max(np.abs(got[op] - ref[op])) / max(np.max(np.abs(ref[op])), 1.0)) for op in ref}
 
 
-def compare(chain, states: States, workdir: Path, opts=("-O2", "-O3"), rounds: int = 7, peers: bool = True,
-            log=print) -> dict:
+def compare(
+    chain, states: States, workdir: Path, opts=("-O2", "-O3"), rounds: int = 7, peers: bool = True, log=print
+) -> dict:
     """Every tool on `chain` and `states` at each optimisation level: agreement with apair first,
     then `rounds` round-robin rounds (each program evaluates every operation over all poses once
     per round); the minimum ns per evaluation over the rounds. apair runs twice: its generic
@@ -457,7 +518,7 @@ def compare(chain, states: States, workdir: Path, opts=("-O2", "-O3"), rounds: i
         outputs[name] = read_outputs(workdir / "out.bin", n)
     ref = outputs[f"apair {opts[0]}"]
     best: dict[str, dict] = {name: {} for name in tools}
-    for r in range(rounds):
+    for _r in range(rounds):
         for name, exe in tools.items():
             times = run_program(exe, inputs, workdir / "out.bin", 1)
             for op, t in times.items():

@@ -25,6 +25,7 @@ the operation count of each generated kernel after CSE, growth with n and with t
 the time of a whole `make generate`, and inverse kinematics of 4A-chains. Results go to
 bench/results.json (or --out). Nothing here is asserted: the targets are reported as met or missed.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -61,9 +62,11 @@ def per_item(fn, items: int, repeats: int) -> dict:
 
 def loop(fn, args_list):
     """fn(*args) for every args in the list, as a Python loop."""
+
     def run():
         for args in args_list:
             fn(*args)
+
     return run
 
 
@@ -77,9 +80,15 @@ def random_chain(n: int, rng) -> apair.AChain:
         principal = m / 12 * np.array([y * y + z * z, x * x + z * z, x * x + y * y])
         Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
         links.append(apair.Link(m, rng.uniform(-0.3, 0.3, 3), Q @ np.diag(principal) @ Q.T))
-    return apair.AChain([apair.APair.revolute() for _ in range(n)], rng.uniform(0.1, 0.5, n),
-                        rng.uniform(-np.pi, np.pi, n), rng.uniform(-0.3, 0.3, n), rng.uniform(-np.pi, np.pi, n),
-                        links=links, gravity=(0.0, 0.0, -9.81))
+    return apair.AChain(
+        [apair.APair.revolute() for _ in range(n)],
+        rng.uniform(0.1, 0.5, n),
+        rng.uniform(-np.pi, np.pi, n),
+        rng.uniform(-0.3, 0.3, n),
+        rng.uniform(-np.pi, np.pi, n),
+        links=links,
+        gravity=(0.0, 0.0, -9.81),
+    )
 
 
 def pin_model(chain: apair.AChain):
@@ -91,8 +100,12 @@ def pin_model(chain: apair.AChain):
     for i in range(chain.n):
         parent = model.addJoint(parent, pin.JointModelRZ(), placement, f"r{i}")
         a, alpha, c, phi = chain.a[i], chain.alpha[i], chain.offset[i], chain.theta_offset[i]
-        D = (pin.SE3(pin.utils.rotate("z", phi), np.zeros(3)) * pin.SE3(np.eye(3), np.array([0, 0, c]))
-             * pin.SE3(np.eye(3), np.array([a, 0, 0])) * pin.SE3(pin.utils.rotate("x", alpha), np.zeros(3)))
+        D = (
+            pin.SE3(pin.utils.rotate("z", phi), np.zeros(3))
+            * pin.SE3(np.eye(3), np.array([0, 0, c]))
+            * pin.SE3(np.eye(3), np.array([a, 0, 0]))
+            * pin.SE3(pin.utils.rotate("x", alpha), np.zeros(3))
+        )
         L = chain.links[i]
         model.appendBodyToJoint(parent, D.act(pin.Inertia(L.mass, L.com, L.inertia)), pin.SE3.Identity())
         placement = D
@@ -114,11 +127,13 @@ def pin_functions(chain):
         pin.framesForwardKinematics(model, data, q)
         return data.oMf[fid].homogeneous
 
-    timed = {"fk": lambda q: pin.framesForwardKinematics(model, data, q),
-             "jacobian": lambda q: pin.computeFrameJacobian(model, data, q, fid, world),
-             "mass_matrix": lambda q: pin.crba(model, data, q),  # the upper triangle only
-             "inverse_dynamics": lambda q, qd, qdd: pin.rnea(model, data, q, qd, qdd),
-             "forward_dynamics": lambda q, qd, tau: pin.aba(model, data, q, qd, tau)}
+    timed = {
+        "fk": lambda q: pin.framesForwardKinematics(model, data, q),
+        "jacobian": lambda q: pin.computeFrameJacobian(model, data, q, fid, world),
+        "mass_matrix": lambda q: pin.crba(model, data, q),  # the upper triangle only
+        "inverse_dynamics": lambda q, qd, qdd: pin.rnea(model, data, q, qd, qdd),
+        "forward_dynamics": lambda q, qd, tau: pin.aba(model, data, q, qd, tau),
+    }
     return timed, dict(timed, fk=fk_pose)
 
 
@@ -195,24 +210,33 @@ def bench_chain(n: int, rng, batch: int, single: int, slow: int, repeats: int, p
         one = lambda k: [x[k] if a["name"] in per_pose else x for x, a in zip(inputs, spec_j["inputs"])]
         row["c_batched"] = per_item(lambda: kernels.call(name, *inputs), batch, repeats)
         row["c_single"] = per_item(loop(kernels.call, [(name, *one(k)) for k in range(single)]), single, repeats)
-        api_args = {"fk": lambda k: (q[k],), "jacobian": lambda k: (q[k],), "mass_matrix": lambda k: (q[k],),
-                    "inverse_dynamics": lambda k: (q[k], qd[k], qdd[k]),
-                    "forward_dynamics": lambda k: (q[k], qd[k], tau[k])}[op]
+        api_args = {
+            "fk": lambda k: (q[k],),
+            "jacobian": lambda k: (q[k],),
+            "mass_matrix": lambda k: (q[k],),
+            "inverse_dynamics": lambda k: (q[k], qd[k], qdd[k]),
+            "forward_dynamics": lambda k: (q[k], qd[k], tau[k]),
+        }[op]
         method = getattr(chain, op)
         row["c_single_api"] = per_item(loop(method, [api_args(k) for k in range(single)]), single, repeats)
         if specialised.specialised:
-            row["specialised_single_api"] = per_item(loop(getattr(specialised, op), [api_args(k) for k in range(single)]),
-                                                     single, repeats)
+            row["specialised_single_api"] = per_item(
+                loop(getattr(specialised, op), [api_args(k) for k in range(single)]), single, repeats
+            )
         row["numpy_batched"] = per_item(lambda: NUMPY_KERNELS[name](*inputs), batch, repeats)
         spec = sp_specs[name]
         flat = flat_inputs(spec, inputs)
         sfun = sympy_function(spec)
         row["lambdify_loop"] = per_item(loop(sfun, [tuple(flat[k]) for k in range(slow)]), slow, repeats)
-        reference = kernels.call(name, *[x[:10] if a["name"] in per_pose else x
-                                         for x, a in zip(inputs, spec_j["inputs"])])[0]
-        checks = {"lambdify": np.array([sfun(*flat[k]) for k in range(10)]),
-                  "numpy": NUMPY_KERNELS[name](*[x[:10] if a["name"] in per_pose else x
-                                                 for x, a in zip(inputs, spec_j["inputs"])])}
+        reference = kernels.call(
+            name, *[x[:10] if a["name"] in per_pose else x for x, a in zip(inputs, spec_j["inputs"])]
+        )[0]
+        checks = {
+            "lambdify": np.array([sfun(*flat[k]) for k in range(10)]),
+            "numpy": NUMPY_KERNELS[name](
+                *[x[:10] if a["name"] in per_pose else x for x, a in zip(inputs, spec_j["inputs"])]
+            ),
+        }
         if se_ok:
             efun, backend = symengine_function(spec)
             row["symengine_backend"] = backend
@@ -220,15 +244,15 @@ def bench_chain(n: int, rng, batch: int, single: int, slow: int, repeats: int, p
             row["symengine_single"] = per_item(loop(efun, [(flat[k],) for k in range(single)]), single, repeats)
             checks["symengine"] = efun(flat[:10])
         if pin_ok:
-            row["pinocchio_per_call"] = per_item(loop(pin_f[op], [api_args(k) for k in range(single)]), single,
-                                                 repeats)
+            row["pinocchio_per_call"] = per_item(loop(pin_f[op], [api_args(k) for k in range(single)]), single, repeats)
             got = np.array([pin_check[op](*api_args(k)) for k in range(10)])
             if op == "mass_matrix":
                 got = np.triu(got) + np.swapaxes(np.triu(got, 1), -1, -2)
             checks["pinocchio"] = got
         ref = np.asarray(reference).reshape(10, -1)
-        row["max_abs_difference"] = {k: float(np.max(np.abs(np.asarray(v, dtype=float).reshape(10, -1) - ref)))
-                                     for k, v in checks.items()}
+        row["max_abs_difference"] = {
+            k: float(np.max(np.abs(np.asarray(v, dtype=float).reshape(10, -1) - ref))) for k, v in checks.items()
+        }
         c = row["c_batched"]["median_ns"]
         ratios = {}
         for peer in ("numpy_batched", "lambdify_loop", "symengine_batched", "pinocchio_per_call"):
@@ -250,8 +274,15 @@ def batch_scaling(n: int, rng, repeats: int) -> dict:
         rows = {}
         for size in (1, 10, 100, 1000, 10_000, 100_000):
             q = rng.uniform(-np.pi, np.pi, (size, n))
-            args = {"law": chain._law(q), "qd": q, "qdd": q, "dh": chain._dh, "links": chain._links,
-                    "legs": chain._legs, "gravity": chain.gravity}
+            args = {
+                "law": chain._law(q),
+                "qd": q,
+                "qdd": q,
+                "dh": chain._dh,
+                "links": chain._links,
+                "legs": chain._legs,
+                "gravity": chain.gravity,
+            }
             inputs = [args[a["name"]] for a in kernels.manifest()["kernels"][name]["inputs"]]
             calls = max(1, 20_000 // size)
             rows[size] = per_item(loop(kernels.call, [(name, *inputs)] * calls), size * calls, repeats)
@@ -263,8 +294,13 @@ def time_generate() -> float:
     """Seconds for the whole derivation and code generation (`make generate`), into a scratch folder."""
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "codegen", "--out", tmp], cwd=ROOT, check=True,
-                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        subprocess.run(
+            [sys.executable, "-m", "codegen", "--out", tmp],
+            cwd=ROOT,
+            check=True,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         return time.perf_counter() - t0
 
 
@@ -276,18 +312,31 @@ def time_codegen(chain) -> float:
     for p, a, al, c, ph, link in zip(chain.pairs, chain.a, chain.alpha, chain.offset, chain.theta_offset, chain.links):
         lines += ["[[joint]]", f'pair = "{p.kind}"']
         if p.kind != "revolute":
-            lines += [f"base_radius = {num(p.base_radius)}", f"platform_radius = {num(p.platform_radius)}",
-                      f"leg_mass = {num(p.leg_mass)}"]
+            lines += [
+                f"base_radius = {num(p.base_radius)}",
+                f"platform_radius = {num(p.platform_radius)}",
+                f"leg_mass = {num(p.leg_mass)}",
+            ]
         I = link.inertia
-        lines += [f"a = {num(a)}", f"alpha = {num(al)}", f"offset = {num(c)}", f"theta_offset = {num(ph)}",
-                  f"mass = {num(link.mass)}", f"com = [{', '.join(map(num, link.com))}]",
-                  f"inertia = [{', '.join(map(num, (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])))}]", ""]
+        lines += [
+            f"a = {num(a)}",
+            f"alpha = {num(al)}",
+            f"offset = {num(c)}",
+            f"theta_offset = {num(ph)}",
+            f"mass = {num(link.mass)}",
+            f"com = [{', '.join(map(num, link.com))}]",
+            f"inertia = [{', '.join(map(num, (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])))}]",
+            "",
+        ]
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "arm6.toml"
         path.write_text("\n".join(lines))
         t0 = time.perf_counter()
-        res = subprocess.run([sys.executable, "-m", "apair", "codegen", str(path), "--out", str(Path(tmp) / "out")],
-                             capture_output=True, text=True)
+        res = subprocess.run(
+            [sys.executable, "-m", "apair", "codegen", str(path), "--out", str(Path(tmp) / "out")],
+            capture_output=True,
+            text=True,
+        )
         if res.returncode != 0:
             raise RuntimeError(f"apair codegen failed: {res.stderr.strip()}")
         return time.perf_counter() - t0
@@ -309,15 +358,28 @@ def native_section(rng, quick: bool) -> dict:
     work = ROOT / "build" / "bench"
     out = {}
     example = apair.load(ROOT / "examples" / "4a_chain.toml")
-    for label, chain in (("R-chain", random_chain(6, rng)), ("A-chain", random_achain(6, rng)),
-                         ("examples/4a_chain.toml", example)):
+    for label, chain in (
+        ("R-chain", random_chain(6, rng)),
+        ("A-chain", random_achain(6, rng)),
+        ("examples/4a_chain.toml", example),
+    ):
         n = chain.n
         lim = np.array([min(p.theta_limit or np.pi, np.pi) * 0.95 for p in chain.pairs])
-        states = native.States(rng.uniform(-lim, lim, (count, n)), rng.normal(size=(count, n)),
-                               rng.normal(size=(count, n)), rng.normal(size=(count, n)))
+        states = native.States(
+            rng.uniform(-lim, lim, (count, n)),
+            rng.normal(size=(count, n)),
+            rng.normal(size=(count, n)),
+            rng.normal(size=(count, n)),
+        )
         print(f"compiled comparison, {label} (n = {n}, {count} states):", file=sys.stderr, flush=True)
-        out[label] = native.compare(chain, states, work / label, rounds=rounds, peers=label == "R-chain",
-                                    log=lambda m: print(m, file=sys.stderr, flush=True))
+        out[label] = native.compare(
+            chain,
+            states,
+            work / label,
+            rounds=rounds,
+            peers=label == "R-chain",
+            log=lambda m: print(m, file=sys.stderr, flush=True),
+        )
     manifest = kernels.manifest()["kernels"]
     out["apair_ops_per_item"] = {op: manifest[f"{op}6"]["ops_per_item"] for op in native.OPERATIONS}
     return out
@@ -340,8 +402,13 @@ def native_targets(native_res: dict) -> list[dict]:
                 continue
             for op in OPERATIONS:
                 r = spec["ns"][op] / other["ns"][op]
-                out.append({"target": f"{op} {opt}, {label}: specialised <= {bound} x {peer}", "measured": r,
-                            "met": r <= bound})
+                out.append(
+                    {
+                        "target": f"{op} {opt}, {label}: specialised <= {bound} x {peer}",
+                        "measured": r,
+                        "met": r <= bound,
+                    }
+                )
     for opt in ("-O2", "-O3"):
         me = tools.get(f"apair {opt}")
         if me is None:
@@ -359,8 +426,9 @@ def native_targets(native_res: dict) -> list[dict]:
                 out.append({"target": f"{op} {opt}: apair <= {bound} x {peer}", "measured": r, "met": r <= bound})
             if op in ("fk", "jacobian"):
                 r = me["ns"][op] / floor
-                out.append({"target": f"{op} {opt}: apair <= 1.3 x its sincos calls alone", "measured": r,
-                            "met": r <= 1.3})
+                out.append(
+                    {"target": f"{op} {opt}: apair <= 1.3 x its sincos calls alone", "measured": r, "met": r <= 1.3}
+                )
     return out
 
 
@@ -380,25 +448,35 @@ def print_native(native_res: dict) -> None:
     for opt in ("-O2", "-O3"):
         me = r["tools"].get(f"apair {opt}")
         if me:
-            print(f"apair {opt}: sincos of the 6 half angles alone {me['ns']['trig_floor']:.0f} ns, "
-                  f"the 6 law kernels {me['ns']['law_kernels']:.0f} ns")
+            print(
+                f"apair {opt}: sincos of the 6 half angles alone {me['ns']['trig_floor']:.0f} ns, "
+                f"the 6 law kernels {me['ns']['law_kernels']:.0f} ns"
+            )
     worst = max(v for t in r["tools"].values() for v in t["difference"].values())
     print(f"largest difference from apair (relative to the largest value): {worst:.1e}")
-    print("operations per evaluation: apair " + ", ".join(f"{k} {v}" for k, v in native_res["apair_ops_per_item"].items()))
+    print(
+        "operations per evaluation: apair " + ", ".join(f"{k} {v}" for k, v in native_res["apair_ops_per_item"].items())
+    )
     if "casadi_ops" in r:
         print("CasADi SX operations: " + ", ".join(f"{k} {v}" for k, v in r["casadi_ops"].items()))
     for tool, why in r["skipped"].items():
         print(f"skipped {tool}: {why}")
     for label in ("A-chain", "examples/4a_chain.toml"):
         a = native_res[label]
-        print(f"{label} (n = {a['n']}, sinusoidal pairs with leg mass), apair only, ns: " + "; ".join(
-            f"{name}: " + ", ".join(f"{op} {t:.0f}" for op, t in a['tools'][name]['ns'].items()) for name in a["tools"]))
+        print(
+            f"{label} (n = {a['n']}, sinusoidal pairs with leg mass), apair only, ns: "
+            + "; ".join(
+                f"{name}: " + ", ".join(f"{op} {t:.0f}" for op, t in a["tools"][name]["ns"].items())
+                for name in a["tools"]
+            )
+        )
 
 
 def random_4a(rng) -> apair.AChain:
     pairs = [apair.APair(*rng.uniform(0.03, 0.1, 2)) for _ in range(4)]
-    return apair.AChain(pairs, rng.uniform(0.1, 0.4, 4), rng.uniform(-1.5, 1.5, 4), rng.uniform(-0.1, 0.1, 4),
-                        rng.uniform(-1.0, 1.0, 4))
+    return apair.AChain(
+        pairs, rng.uniform(0.1, 0.4, 4), rng.uniform(-1.5, 1.5, 4), rng.uniform(-0.1, 0.1, 4), rng.uniform(-1.0, 1.0, 4)
+    )
 
 
 def _plain(x):
@@ -422,16 +500,23 @@ def time_ik(chains, poses_per_chain: int, rng) -> dict:
             times.append(time.perf_counter() - t0)
             solutions.append(len(q))
     ms = np.array(times) * 1e3
-    return {"poses": len(times), "median_ms": float(np.median(ms)), "min_ms": float(ms.min()),
-            "max_ms": float(ms.max()), "p90_ms": float(np.percentile(ms, 90)),
-            "first_call_ms": float(np.median(setup) * 1e3), "solutions_per_pose": float(np.mean(solutions))}
+    return {
+        "poses": len(times),
+        "median_ms": float(np.median(ms)),
+        "min_ms": float(ms.min()),
+        "max_ms": float(ms.max()),
+        "p90_ms": float(np.percentile(ms, 90)),
+        "first_call_ms": float(np.median(setup) * 1e3),
+        "solutions_per_pose": float(np.mean(solutions)),
+    }
 
 
 def random_pattern_chain(pattern: str, rng) -> apair.AChain:
     n = len(pattern)
     pairs = [apair.APair.revolute() if c == "R" else apair.APair(*rng.uniform(0.05, 0.12, 2)) for c in pattern]
-    return apair.AChain(pairs, rng.uniform(0.1, 0.5, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.2, 0.2, n),
-                        rng.uniform(-1.0, 1.0, n))
+    return apair.AChain(
+        pairs, rng.uniform(0.1, 0.5, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.2, 0.2, n), rng.uniform(-1.0, 1.0, n)
+    )
 
 
 TRACE_MAX = 48  # start sets the bench certifies by the trace test (larger ones: see apair.ik.homotopy.trace)
@@ -475,11 +560,23 @@ def time_ik6(pattern: str, poses: int, rng) -> dict:
             else:
                 os.environ["APAIR_CACHE"] = old
     ms = np.array(times) * 1e3
-    return {"pattern": pattern, "poses": poses, "median_ms": float(np.median(ms)), "max_ms": float(ms.max()),
-            "prepare_s": prep, "first_call_ms": first * 1e3, "start_count": start.count, "start_certified": start.certified,
-            "start_how": start.how,
-            "trace_s": trace_s, "trace_deviation": start.trace if start.traced else None, "witnesses": start.witnesses,
-            "round_trips_found": found, "certified_poses": certified, "methods": methods}
+    return {
+        "pattern": pattern,
+        "poses": poses,
+        "median_ms": float(np.median(ms)),
+        "max_ms": float(ms.max()),
+        "prepare_s": prep,
+        "first_call_ms": first * 1e3,
+        "start_count": start.count,
+        "start_certified": start.certified,
+        "start_how": start.how,
+        "trace_s": trace_s,
+        "trace_deviation": start.trace if start.traced else None,
+        "witnesses": start.witnesses,
+        "round_trips_found": found,
+        "certified_poses": certified,
+        "methods": methods,
+    }
 
 
 def time_ik_local(rng, count: int = 2000) -> dict:
@@ -494,8 +591,12 @@ def time_ik_local(rng, count: int = 2000) -> dict:
         t0 = time.perf_counter()
         res = chain.ik_local(T, seeds)
         best = min(best, time.perf_counter() - t0)
-    return {"count": count, "us_per_solve": best / count * 1e6, "converged": float(res.converged.mean()),
-            "us_per_converged": best / max(res.converged.sum(), 1) * 1e6}
+    return {
+        "count": count,
+        "us_per_solve": best / count * 1e6,
+        "converged": float(res.converged.mean()),
+        "us_per_converged": best / max(res.converged.sum(), 1) * 1e6,
+    }
 
 
 # ------------------------------------------------------------------------------------ report
@@ -511,40 +612,74 @@ def targets(results: dict) -> list[dict]:
         row = six.get(op, {})
         if "pinocchio_per_call" in row:
             r = row["peer_over_c_batched"]["pinocchio_per_call"]
-            out.append({"target": f"batched C >= 2x faster than Pinocchio per call, {op}, n = 6", "measured": r,
-                        "met": r >= 2.0})
+            out.append(
+                {
+                    "target": f"batched C >= 2x faster than Pinocchio per call, {op}, n = 6",
+                    "measured": r,
+                    "met": r >= 2.0,
+                }
+            )
     for op in ("fk", "jacobian", "mass_matrix", "inverse_dynamics", "forward_dynamics"):
         row = six.get(op, {})
         for mine, what in (("c_single_api", "generic"), ("specialised_single_api", "specialised")):
             if "pinocchio_per_call" in row and mine in row:
                 r = row[mine]["median_ns"] / row["pinocchio_per_call"]["median_ns"]
-                out.append({"target": f"Python single call, {what} chain.{op}, n = 6: <= 1.0 x Pinocchio's Python call",
-                            "measured": r, "met": r <= 1.0})
+                out.append(
+                    {
+                        "target": f"Python single call, {what} chain.{op}, n = 6: <= 1.0 x Pinocchio's Python call",
+                        "measured": r,
+                        "met": r <= 1.0,
+                    }
+                )
     if results.get("codegen_6_s") is not None:
         g = results["codegen_6_s"]
         out.append({"target": "apair codegen of a 6-joint chain, every kernel, < 60 s", "measured": g, "met": g < 60})
     worst = max(row["single_call_overhead_ns"] for rows in results["kernels"].values() for row in rows.values())
-    out.append({"target": "single-call Python overhead (apair.kernels.call, best of repeats) < 2 µs, worst kernel",
-                "measured": worst / 1e3, "met": worst < 2000})
-    worst_np = min(row["peer_over_c_batched"]["lambdify_loop"] / row["peer_over_c_batched"]["numpy_batched"]
-                   for rows in results["kernels"].values() for row in rows.values())
-    out.append({"target": "batched NumPy >= 10x faster than a Python loop over lambdify, worst case",
-                "measured": worst_np, "met": worst_np >= 10})
+    out.append(
+        {
+            "target": "single-call Python overhead (apair.kernels.call, best of repeats) < 2 µs, worst kernel",
+            "measured": worst / 1e3,
+            "met": worst < 2000,
+        }
+    )
+    worst_np = min(
+        row["peer_over_c_batched"]["lambdify_loop"] / row["peer_over_c_batched"]["numpy_batched"]
+        for rows in results["kernels"].values()
+        for row in rows.values()
+    )
+    out.append(
+        {
+            "target": "batched NumPy >= 10x faster than a Python loop over lambdify, worst case",
+            "measured": worst_np,
+            "met": worst_np >= 10,
+        }
+    )
     if results.get("make_generate_s") is not None:
         g = results["make_generate_s"]
         out.append({"target": "make generate < 120 s", "measured": g, "met": g < 120})
     for pattern, bound in (("RRRRRR", 1.0), ("ARRRRR", 5.0), ("AAAAAA", 1000.0)):
         r = results.get("ik6", {}).get(pattern)
         if r:
-            out.append({"target": f"ik of a 6-joint {pattern} chain, all solutions, median per pose <= {bound:g} ms",
-                        "measured": r["median_ms"], "met": r["median_ms"] <= bound})
+            out.append(
+                {
+                    "target": f"ik of a 6-joint {pattern} chain, all solutions, median per pose <= {bound:g} ms",
+                    "measured": r["median_ms"],
+                    "met": r["median_ms"] <= bound,
+                }
+            )
     if results.get("ik_local"):
         r = results["ik_local"]["us_per_converged"]
-        out.append({"target": "ik_local, n = 6, seed within 0.3 rad: <= 20 µs per converged solve", "measured": r,
-                    "met": r <= 20})
+        out.append(
+            {
+                "target": "ik_local, n = 6, seed within 0.3 rad: <= 20 µs per converged solve",
+                "measured": r,
+                "met": r <= 20,
+            }
+        )
     for name, r in results.get("ik", {}).items():
-        out.append({"target": f"4-joint ik ({name}) <= 1 ms median", "measured": r["median_ms"],
-                    "met": r["median_ms"] <= 1.0})
+        out.append(
+            {"target": f"4-joint ik ({name}) <= 1 ms median", "measured": r["median_ms"], "met": r["median_ms"] <= 1.0}
+        )
     return out
 
 
@@ -557,21 +692,31 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     try:
         import pinocchio  # noqa: F401
+
         pin_ok = True
     except ImportError:
         pin_ok = False
     try:
         import symengine  # noqa: F401
+
         se_ok = True
     except ImportError:
         se_ok = False
     rng = np.random.default_rng(0)
     batch, single, slow, repeats = (1000, 200, 20, 3) if args.quick else (10_000, 2000, 200, 7)
-    results = {"machine": {"python": sys.version.split()[0], "platform": platform.platform(),
-                           "processor": platform.processor() or platform.machine(), "numpy": np.__version__,
-                           "apair_backend": apair.backend(), "pinocchio": pin_ok, "symengine": se_ok},
-               "settings": {"batch": batch, "single_calls": single, "lambdify_calls": slow, "repeats": repeats},
-               "kernels": {}}
+    results = {
+        "machine": {
+            "python": sys.version.split()[0],
+            "platform": platform.platform(),
+            "processor": platform.processor() or platform.machine(),
+            "numpy": np.__version__,
+            "apair_backend": apair.backend(),
+            "pinocchio": pin_ok,
+            "symengine": se_ok,
+        },
+        "settings": {"batch": batch, "single_calls": single, "lambdify_calls": slow, "repeats": repeats},
+        "kernels": {},
+    }
     if not (pin_ok and se_ok):
         print("note: install the bench extra (pip install .[bench]) for Pinocchio and symengine", file=sys.stderr)
     results["native"] = native_section(rng, args.quick)
@@ -588,21 +733,34 @@ def main(argv=None) -> int:
         print(f"n = {n}: deriving the expressions for lambdify/symengine and timing ...", file=sys.stderr, flush=True)
         results["kernels"][str(n)] = bench_chain(n, rng, batch, single, slow, repeats, pin_ok, se_ok)
     results["batch_scaling"] = batch_scaling(6, rng, repeats)
-    cases = {"4A random generic designs": ([random_4a(rng) for _ in range(3 if args.quick else 10)], 10 if args.quick else 50),
-             "examples/4a_chain.toml": ([apair.load(ROOT / "examples/4a_chain.toml")], 20 if args.quick else 200)}
+    cases = {
+        "4A random generic designs": (
+            [random_4a(rng) for _ in range(3 if args.quick else 10)],
+            10 if args.quick else 50,
+        ),
+        "examples/4a_chain.toml": ([apair.load(ROOT / "examples/4a_chain.toml")], 20 if args.quick else 200),
+    }
     results["ik"] = {name: time_ik(chains, k, rng) for name, (chains, k) in cases.items()}
-    results["ik6"] = {p: time_ik6(p, 20 if args.quick else 100, rng)
-                      for p in ("RRRRRR", "ARRRRR") + (() if args.quick else ("AAAAAA",))}
+    results["ik6"] = {
+        p: time_ik6(p, 20 if args.quick else 100, rng)
+        for p in ("RRRRRR", "ARRRRR") + (() if args.quick else ("AAAAAA",))
+    }
     results["ik_local"] = time_ik_local(rng)
     results["make_generate_s"] = None if args.no_generate else time_generate()
     results["codegen_6_s"] = time_codegen(random_achain(6, rng))
     results["targets"] = targets(results)
 
     print("\nper evaluation, median over repeats (ratio = peer time / batched C time):")
-    cols = [("c_batched", "C batched"), ("c_single", "C 1 call"), ("c_single_api", "API 1 call"),
-            ("specialised_single_api", "specialised 1"),
-            ("numpy_batched", "NumPy batch"), ("lambdify_loop", "lambdify loop"), ("symengine_batched", "symengine"),
-            ("pinocchio_per_call", "Pinocchio")]
+    cols = [
+        ("c_batched", "C batched"),
+        ("c_single", "C 1 call"),
+        ("c_single_api", "API 1 call"),
+        ("specialised_single_api", "specialised 1"),
+        ("numpy_batched", "NumPy batch"),
+        ("lambdify_loop", "lambdify loop"),
+        ("symengine_batched", "symengine"),
+        ("pinocchio_per_call", "Pinocchio"),
+    ]
     print(f"{'kernel':24s}{'ops':>7s}" + "".join(f"{c[1]:>15s}" for c in cols))
     for n, rows in results["kernels"].items():
         for op, row in rows.items():
@@ -612,29 +770,40 @@ def main(argv=None) -> int:
                     cells.append(f"{'-':>15s}")
                     continue
                 r = row["peer_over_c_batched"].get(key)
-                cells.append(f"{fmt(row[key]['median_ns']) + (f' ({r:.0f}x)' if r and r >= 10 else f' ({r:.1f}x)' if r else ''):>15s}")
+                cells.append(
+                    f"{fmt(row[key]['median_ns']) + (f' ({r:.0f}x)' if r and r >= 10 else f' ({r:.1f}x)' if r else ''):>15s}"
+                )
             print(f"{op + ' n=' + n:24s}{row['ops']:>7d}" + "".join(cells))
     print("\nbatch scaling (C, ns per item):")
     for name, rows in results["batch_scaling"].items():
         print(f"  {name:20s}" + "  ".join(f"{size}: {fmt(r['median_ns'])}" for size, r in rows.items()))
     print("\ninverse kinematics per pose (all real solutions, verified):")
     for name, r in results["ik"].items():
-        print(f"  {name:30s} median {r['median_ms']:.2f} ms (min {r['min_ms']:.2f}, max {r['max_ms']:.2f}; "
-              f"{r['solutions_per_pose']:.1f} solutions)")
+        print(
+            f"  {name:30s} median {r['median_ms']:.2f} ms (min {r['min_ms']:.2f}, max {r['max_ms']:.2f}; "
+            f"{r['solutions_per_pose']:.1f} solutions)"
+        )
     for p, r in results["ik6"].items():
-        print(f"  6-joint {p:24s} median {r['median_ms']:.2f} ms, worst {r['max_ms']:.2f} ms over {r['poses']} poses "
-              f"({r['round_trips_found']} round trips found, {r['certified_poses']} certified; "
-              + ", ".join(f"{k} {v}" for k, v in sorted(r["methods"].items())) + "); start system "
-              f"{r['start_count']} solutions prepared in {r['prepare_s']:.1f} s, "
-              + (f"trace test {'passed' if r['start_certified'] else 'FAILED'} in {r['trace_s']:.1f} s (deviation "
-                 f"{r['trace_deviation']:.0e}, {r['witnesses']} witnesses)" if r["trace_s"] is not None else
-                 f"no trace test ({'' if r['start_certified'] else 'not '}certified: {r['start_how']})"))
+        print(
+            f"  6-joint {p:24s} median {r['median_ms']:.2f} ms, worst {r['max_ms']:.2f} ms over {r['poses']} poses "
+            f"({r['round_trips_found']} round trips found, {r['certified_poses']} certified; "
+            + ", ".join(f"{k} {v}" for k, v in sorted(r["methods"].items()))
+            + "); start system "
+            f"{r['start_count']} solutions prepared in {r['prepare_s']:.1f} s, "
+            + (
+                f"trace test {'passed' if r['start_certified'] else 'FAILED'} in {r['trace_s']:.1f} s (deviation "
+                f"{r['trace_deviation']:.0e}, {r['witnesses']} witnesses)"
+                if r["trace_s"] is not None
+                else f"no trace test ({'' if r['start_certified'] else 'not '}certified: {r['start_how']})"
+            )
+        )
     r = results["ik_local"]
     print(f"  ik_local n = 6: {r['us_per_converged']:.2f} µs per converged solve ({r['converged']:.1%} converged)")
     if results["make_generate_s"] is not None:
         print(f"\nmake generate (derivations + code generation): {results['make_generate_s']:.1f} s")
-    worst = max(v for rows in results["kernels"].values() for row in rows.values()
-                for v in row["max_abs_difference"].values())
+    worst = max(
+        v for rows in results["kernels"].values() for row in rows.values() for v in row["max_abs_difference"].values()
+    )
     print(f"largest difference between the tools' results: {worst:.2e}")
     print("\ntargets:")
     for t in results["targets"]:

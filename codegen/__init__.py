@@ -5,6 +5,7 @@ regenerates generated/), `apair.codegen` and `apair.derivations` in an installed
 generates code for a user's own chain (`apair codegen`). `derivation(name)` imports the sibling's
 module either way.
 """
+
 import importlib
 
 _DERIVATIONS = "derivations" if __name__ == "codegen" else __name__.rpartition(".")[0] + ".derivations"

@@ -6,6 +6,7 @@ and prints its kernels in a worker process (lowering/); the results are put back
 order (derivation, then part), so the output does not depend on which worker finished first. The
 backends then render them (render.py: C, NumPy, JavaScript, the polynomial sets, the manifest).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -21,15 +22,35 @@ from .lowering import lower
 from .output import OutputError, write
 from .render import render_all
 
-DERIVATIONS = ("apair_collisions", "apair_pair", "apair_dynamics", "chain_kinematics", "chain_dynamics",
-               "chain_variety", "chain_ik", "chain_ik6r", "chain_ik1a5r")
+DERIVATIONS = (
+    "apair_collisions",
+    "apair_pair",
+    "apair_dynamics",
+    "chain_kinematics",
+    "chain_dynamics",
+    "chain_variety",
+    "chain_ik",
+    "chain_ik6r",
+    "chain_ik1a5r",
+)
 ROOT = Path(__file__).resolve().parent.parent
 # Rough cost of each job on one core [s], for scheduling the longest first.
-COST = {("chain_dynamics", 6): 40, ("chain_dynamics", 5): 28, ("chain_dynamics", 4): 20,
-        ("chain_dynamics", "check"): 15, ("apair_dynamics", None): 9, ("apair_pair", None): 8,
-        ("chain_variety", None): 7, ("chain_dynamics", 3): 6, ("chain_kinematics", None): 6, ("chain_ik", None): 20,
-        ("chain_ik6r", None): 3,
-        ("chain_ik1a5r", 1): 12, ("chain_ik1a5r", 2): 12, ("chain_ik1a5r", 3): 12}
+COST = {
+    ("chain_dynamics", 6): 40,
+    ("chain_dynamics", 5): 28,
+    ("chain_dynamics", 4): 20,
+    ("chain_dynamics", "check"): 15,
+    ("apair_dynamics", None): 9,
+    ("apair_pair", None): 8,
+    ("chain_variety", None): 7,
+    ("chain_dynamics", 3): 6,
+    ("chain_kinematics", None): 6,
+    ("chain_ik", None): 20,
+    ("chain_ik6r", None): 3,
+    ("chain_ik1a5r", 1): 12,
+    ("chain_ik1a5r", 2): 12,
+    ("chain_ik1a5r", 3): 12,
+}
 
 
 def jobs(names) -> list[tuple[str, object]]:
@@ -74,8 +95,10 @@ def main(argv=None) -> int:
         lowered.setdefault(name, []).extend(kernels)
         poly_files.update(polys)
         label = name if part is None else f"{name} [{part}]"
-        print(f"derived and lowered {label}: {len(kernels)} kernels, {len(polys) // 3} polynomial sets "
-              f"({seconds:.1f} s)", file=sys.stderr)
+        print(
+            f"derived and lowered {label}: {len(kernels)} kernels, {len(polys) // 3} polynomial sets ({seconds:.1f} s)",
+            file=sys.stderr,
+        )
     t0 = time.perf_counter()
     files = render_all(lowered, poly_files)
     try:
@@ -83,8 +106,11 @@ def main(argv=None) -> int:
     except OutputError as exc:
         print(f"python -m codegen: error: {exc}", file=sys.stderr)
         return 2
-    print(f"emitted {len(files)} files ({time.perf_counter() - t0:.1f} s; {time.perf_counter() - t_start:.1f} s "
-          f"in all with {args.jobs} jobs); changed: {len(changed)}", file=sys.stderr)
+    print(
+        f"emitted {len(files)} files ({time.perf_counter() - t0:.1f} s; {time.perf_counter() - t_start:.1f} s "
+        f"in all with {args.jobs} jobs); changed: {len(changed)}",
+        file=sys.stderr,
+    )
     for c in changed:
         print(f"  {c}", file=sys.stderr)
     return 0

@@ -6,6 +6,7 @@ backends for the files of generated/, output.py writes them. `Emitter` renders t
 looked up in every backend's folder (its `_template` is the one place they are found, so a test can
 substitute one).
 """
+
 from __future__ import annotations
 
 import json  # noqa: F401 (tests/test_robustness.py reads codegen.emitter.json)
@@ -22,9 +23,27 @@ from .output import OutputError, owned_files, write
 from .render import render_all
 from .templating import VERSION, Templates
 
-__all__ = ["Arg", "Code", "Emitter", "Hoisted", "KernelSpec", "Lowered", "LoweredCall", "OutputError", "PREFIX",
-           "PolynomialSet", "Signature", "VERSION", "WEB_KERNELS", "content_hash", "lower", "owned_files",
-           "render_polynomials", "sources_hash", "write"]
+__all__ = [
+    "Arg",
+    "Code",
+    "Emitter",
+    "Hoisted",
+    "KernelSpec",
+    "Lowered",
+    "LoweredCall",
+    "OutputError",
+    "PREFIX",
+    "PolynomialSet",
+    "Signature",
+    "VERSION",
+    "WEB_KERNELS",
+    "content_hash",
+    "lower",
+    "owned_files",
+    "render_polynomials",
+    "sources_hash",
+    "write",
+]
 
 BACKENDS = Path(__file__).parent / "backends"
 FOLDERS = tuple(BACKENDS / name / "templates" for name in ("c", "numpy", "js", "polynomials", "chain"))
@@ -47,8 +66,9 @@ class Emitter:
         polynomial sets (`render_polynomials`) -> {path under generated/: text}."""
         return render_all(lowered, poly_files, template=self._template)
 
-    def render_chain(self, kernels: list[Lowered], parts: dict[str, Lowered], name: str, meta: dict,
-                     tests: list[dict]) -> dict[str, str]:
+    def render_chain(
+        self, kernels: list[Lowered], parts: dict[str, Lowered], name: str, meta: dict, tests: list[dict]
+    ) -> dict[str, str]:
         """The code of one chain with its design built in (see backends/chain)."""
         return chain.render(kernels, parts, name, meta, tests, template=self._template)
 

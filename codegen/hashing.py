@@ -1,4 +1,5 @@
 """The digests stamped into generated files."""
+
 from __future__ import annotations
 
 import hashlib

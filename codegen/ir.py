@@ -4,6 +4,7 @@ These are plain data (cheap to pickle: codegen/__main__.py lowers in worker proc
 shapes, docs and printed text only; no sympy expression survives lowering. `Arg`, `KernelSpec`
 and `PolynomialSet` are the derivations' own types (derivations/spec.py), re-exported here.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

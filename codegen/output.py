@@ -131,16 +131,18 @@ class _Lock:
                     raise
                 if time.monotonic() > deadline:
                     os.close(self.fd)
-                    raise OutputError(f"--out: {self.out} is being written by another run (waited "
-                                      f"{self.wait:.0f} s for its lock)") from None
+                    raise OutputError(
+                        f"--out: {self.out} is being written by another run (waited {self.wait:.0f} s for its lock)"
+                    ) from None
                 time.sleep(0.05)
 
     def __exit__(self, *exc) -> None:
         os.close(self.fd)  # closing releases the lock
 
 
-def write(files: dict[str, str], out: Path, clean: bool = True, force: bool = False,
-          wait: float = LOCK_WAIT) -> list[str]:
+def write(
+    files: dict[str, str], out: Path, clean: bool = True, force: bool = False, wait: float = LOCK_WAIT
+) -> list[str]:
     """Write `files` ({relative name: text}) under `out`. Where they include MANIFEST, the files
     are recorded in it with their hashes (key "files"), the manifest written last; without it
     (files added to a folder whose manifest another run keeps) the manifest is left alone. With
@@ -167,8 +169,10 @@ def write(files: dict[str, str], out: Path, clean: bool = True, force: bool = Fa
 def _write_locked(payload: dict[str, bytes], out: Path, clean: bool, force: bool) -> list[str]:
     previous = owned_files(out)
     if previous is None and not force and any(out.iterdir()):
-        raise OutputError(f"--out: {out} is not empty and was not written by codegen (no manifest.json of "
-                          "ours): give an empty or new folder, or --force")
+        raise OutputError(
+            f"--out: {out} is not empty and was not written by codegen (no manifest.json of "
+            "ours): give an empty or new folder, or --force"
+        )
     previous = previous or {}
     manifest_text = payload.pop(MANIFEST, None)
     # Refuse before writing anything: every file to write is ours, new, or identical already.
@@ -177,8 +181,9 @@ def _write_locked(payload: dict[str, bytes], out: Path, clean: bool, force: bool
         if force or rel in previous or not (path.exists() or path.is_symlink()) or _same(path, data):
             continue
         kind = "a symbolic link" if path.is_symlink() else "a file"
-        raise OutputError(f"--out: {path} is {kind} that an earlier run did not write: move it away, or "
-                          "--force to replace it")
+        raise OutputError(
+            f"--out: {path} is {kind} that an earlier run did not write: move it away, or --force to replace it"
+        )
     changed = []
     for rel, data in sorted(payload.items()):
         path = _inside(out, rel)

@@ -3,6 +3,7 @@
 Output is deterministic: the same lowered kernels give byte-identical files, each naming the
 derivation that produced it and a content hash of its inputs (the kernel specs and the templates).
 """
+
 from __future__ import annotations
 
 import json
@@ -11,8 +12,10 @@ from .backends import c, js, numpy
 from .ir import Lowered
 from .templating import TemplateSource
 
-INIT = ('"""Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.\n\n'
-        'Content hash: {hash}\n"""\n')
+INIT = (
+    '"""Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.\n\n'
+    'Content hash: {hash}\n"""\n'
+)
 
 
 def manifest_entry(stem: str, k: Lowered, ops_per_item: int) -> dict:
@@ -29,8 +32,9 @@ def manifest_entry(stem: str, k: Lowered, ops_per_item: int) -> dict:
     }
 
 
-def render_all(lowered: dict[str, list[Lowered]], poly_files: dict[str, str],
-               template: TemplateSource | None = None) -> dict[str, str]:
+def render_all(
+    lowered: dict[str, list[Lowered]], poly_files: dict[str, str], template: TemplateSource | None = None
+) -> dict[str, str]:
     """lowered: {derivation module stem: its lowered kernels}; poly_files: the rendered polynomial
     sets (backends.polynomials.render) -> {path under generated/: text}. `template`: where the
     backends find their templates (default: each its own folder)."""
@@ -42,8 +46,13 @@ def render_all(lowered: dict[str, list[Lowered]], poly_files: dict[str, str],
     files.update(numpy.render(lowered, library.content_hash, **own))
     files.update(js.render(kernels, **own))
     files["__init__.py"] = INIT.format(hash=library.content_hash)
-    manifest = {"content_hash": library.content_hash, "prefix": c.PREFIX, "sources_hash": library.sources_hash,
-                "kernels": {k.name: manifest_entry(stem, k, library.ops_per_item[k.name])
-                            for stem, ks in lowered.items() for k in ks}}
+    manifest = {
+        "content_hash": library.content_hash,
+        "prefix": c.PREFIX,
+        "sources_hash": library.sources_hash,
+        "kernels": {
+            k.name: manifest_entry(stem, k, library.ops_per_item[k.name]) for stem, ks in lowered.items() for k in ks
+        },
+    }
     files["manifest.json"] = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
     return files

@@ -5,6 +5,7 @@ its text, with the text of the templates it imports (e.g. c_macros.j2): the cont
 generated file covers that text. `Templates(folder, ...)` is such a callable over the given
 folders; codegen.emitter.Emitter passes its own, over every backend's folder.
 """
+
 from __future__ import annotations
 
 import tomllib

@@ -6,6 +6,7 @@ rational image) and written, like every derived set, as generated/polynomials/va
 tex,json}; `apair show variety_2a_chain` prints it. This runs after `make install` (the engine is
 part of the runtime); `python -m codegen` leaves these files in place.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -42,9 +43,11 @@ def variety_set(path: Path) -> PolynomialSet | None:
         name=f"{PREFIX}{path.stem}",
         title=f"Constraint variety of {chain.name} ({path.name}) in Study parameters",
         source=f"examples/{path.name} by codegen/varieties.py (the exact engine apair.variety)",
-        description=(f"Homogeneous forms in x0..y3 generating every form of degree <= 4 that vanishes on all "
-                     f"poses of the chain (the Study quadric included). A surface of degree {V.degree}; "
-                     f"Hilbert function {hf}."),
+        description=(
+            f"Homogeneous forms in x0..y3 generating every form of degree <= 4 that vanishes on all "
+            f"poses of the chain (the Study quadric included). A surface of degree {V.degree}; "
+            f"Hilbert function {hf}."
+        ),
         entries=entries,
     )
 
@@ -59,8 +62,10 @@ def main(argv=None) -> int:
         ps = variety_set(path)
         if ps is not None:
             files.update(render_polynomial_set(ps, content_hash))
-            print(f"variety of {path.name}: {len(ps.entries)} equations ({time.perf_counter() - t0:.1f} s)",
-                  file=sys.stderr)
+            print(
+                f"variety of {path.name}: {len(ps.entries)} equations ({time.perf_counter() - t0:.1f} s)",
+                file=sys.stderr,
+            )
     try:
         # the variety files are this generator's own, beside generated/'s manifest (not in it)
         changed = write(files, args.out, clean=False, force=True)

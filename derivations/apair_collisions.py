@@ -16,6 +16,7 @@ coordinates as the symbol q3. The runtime (apair.collisions) puts a design in ex
 (through d² = a + b cos θ) and q3 (through their norms), and isolates the real roots in
 t = tan(θ/4) with FLINT; which of them are touches is decided there.
 """
+
 from __future__ import annotations
 
 import random
@@ -89,7 +90,9 @@ def _check(legs, polys, rng: random.Random):
     """At a random design and angle, ρ² from the line and end-point pieces equals the distance
     computed directly (closest points from the normal equations, 30 digits)."""
     mpmath.mp.dps = 30
-    r_b, r_p, d_, th = (sp.Rational(rng.randint(lo, hi), 100) for lo, hi in ((50, 200), (50, 200), (10, 100), (-300, 300)))
+    r_b, r_p, d_, th = (
+        sp.Rational(rng.randint(lo, hi), 100) for lo, hi in ((50, 200), (50, 200), (10, 100), (-300, 300))
+    )
     vals = {apair_pair.r_b: r_b, apair_pair.r_p: r_p, d: d_, c: sp.cos(th / 2), s: sp.sin(th / 2), q3: sp.sqrt(3)}
 
     def num(v):
@@ -119,17 +122,22 @@ def derive():
     legs = leg_points()
     polys = {ij: pieces(*ij, legs) for ij in REPRESENTATIVES}
     _check(legs, polys, random.Random(5))
-    entries = [Entry(f"legs_{i}_{j}_{name}", p, (c, s, d), f"legs {i} and {j}: {name.replace('_', ' ')}")
-               for (i, j), ps in polys.items() for name, p in ps.items()]
+    entries = [
+        Entry(f"legs_{i}_{j}_{name}", p, (c, s, d), f"legs {i} and {j}: {name.replace('_', ' ')}")
+        for (i, j), ps in polys.items()
+        for name, p in ps.items()
+    ]
     entries.append(Entry("plates", d - tau, (c, s, d), "the plates' facing surfaces meet"))
     ps = PolynomialSet(
         name="apair_collisions",
         title="A-pair: leg and plate contacts",
         source=SOURCE,
-        description=("Each polynomial vanishes where two legs (cylinders of diameter rho around the leg "
-                     "segments) or the plates (thickness tau) touch, in c = cos(theta/2), s = sin(theta/2) "
-                     "and the translation d; q3 = sqrt(3). Leg pairs (0, 1), (3, 4), (0, 3), (0, 4), (0, 5) "
-                     "stand for all fifteen by the pair's threefold symmetry."),
+        description=(
+            "Each polynomial vanishes where two legs (cylinders of diameter rho around the leg "
+            "segments) or the plates (thickness tau) touch, in c = cos(theta/2), s = sin(theta/2) "
+            "and the translation d; q3 = sqrt(3). Leg pairs (0, 1), (3, 4), (0, 3), (0, 4), (0, 5) "
+            "stand for all fifteen by the pair's threefold symmetry."
+        ),
         entries=entries,
     )
     return [ps], [], {"pieces": {ij: sorted(p) for ij, p in polys.items()}}

@@ -11,6 +11,7 @@ The derivation works with the law values (d, d', d'') as symbols, then specialis
 sinusoidal and the general pair. This route (explicit energies, sympy differentiation) shares
 nothing with the chain recursion, and the tests compare the two for n = 1.
 """
+
 from __future__ import annotations
 
 import sympy as sp
@@ -31,8 +32,9 @@ r_b, r_p, h, a, b = apair_pair.r_b, apair_pair.r_p, apair_pair.h, apair_pair.a, 
 def derive():
     th = sp.Function("theta")(t)
     D = sp.Function("D")  # d as a function of θ
-    law_subs = lambda e: (e.subs(sp.Derivative(D(theta), (theta, 2)), ddd).subs(sp.Derivative(D(theta), theta), dd)
-                          .subs(D(theta), d))
+    law_subs = lambda e: (
+        e.subs(sp.Derivative(D(theta), (theta, 2)), ddd).subs(sp.Derivative(D(theta), theta), dd).subs(D(theta), d)
+    )
 
     def rz(x):
         return sp.Matrix([[sp.cos(x), -sp.sin(x), 0], [sp.sin(x), sp.cos(x), 0], [0, 0, 1]])
@@ -50,8 +52,8 @@ def derive():
     pts = apair_pair.legs_spec().outputs[0].exprs
     T_legs, V_legs = 0, 0
     for k in range(6):
-        base = sp.Matrix(pts[6 * k:6 * k + 3])
-        tip = sp.Matrix(pts[6 * k + 3:6 * k + 6]).subs({apair_pair.theta: th, apair_pair.d: D(th)})
+        base = sp.Matrix(pts[6 * k : 6 * k + 3])
+        tip = sp.Matrix(pts[6 * k + 3 : 6 * k + 6]).subs({apair_pair.theta: th, apair_pair.d: D(th)})
         vb = tip.diff(t)
         T_legs += m_l / 6 * vb.dot(vb)
         V_legs += m_l * g * (base[2] + tip[2]) / 2
@@ -72,7 +74,9 @@ def derive():
         assert sp.simplify(J_from_tau - J) == 0
         assert sp.simplify(tau - (J * qdd + half_dJ * qd**2 + G)) == 0
         dJ = sp.diff(J.subs({d: D(theta), dd: sp.Derivative(D(theta), theta)}), theta)
-        dJ = dJ.subs(sp.Derivative(D(theta), (theta, 2)), ddd).subs(sp.Derivative(D(theta), theta), dd).subs(D(theta), d)
+        dJ = (
+            dJ.subs(sp.Derivative(D(theta), (theta, 2)), ddd).subs(sp.Derivative(D(theta), theta), dd).subs(D(theta), d)
+        )
         assert sp.simplify(half_dJ - dJ / 2) == 0, "the velocity term must be ½ J'(θ) θ'²"
         dV = sp.diff(Vq.subs(d, D(theta)), theta).subs(sp.Derivative(D(theta), theta), dd)
         assert sp.simplify(G - dV) == 0
@@ -83,7 +87,7 @@ def derive():
     G = sum(p[2] for p in parts.values())
     laws = {"sinusoidal": h * sp.cos(theta / 2), "general": sp.sqrt(a + b * sp.cos(theta))}
     entries = []
-    for label, (Jp, hp, Gp, Tp, Vp) in parts.items():
+    for label, (Jp, _hp, Gp, Tp, Vp) in parts.items():
         entries += [
             Entry(f"T_{label}", sp.Symbol(f"T_{label}"), (), f"kinetic energy of the {label}", rhs=Tp),
             Entry(f"V_{label}", sp.Symbol(f"V_{label}"), (), f"potential energy of the {label}", rhs=Vp),
@@ -91,39 +95,60 @@ def derive():
             Entry(f"G_{label}", sp.Symbol(f"G_{label}"), (), f"{label}: gravity term dV/dtheta", rhs=Gp),
         ]
     entries += [
-        Entry("equation", sp.Symbol("tau"), (), "d, dd, ddd: the law d(theta) and its derivatives",
-              rhs=sp.collect(sp.expand(J * qdd + half_dJ * qd**2 + G), [qdd, qd])),
+        Entry(
+            "equation",
+            sp.Symbol("tau"),
+            (),
+            "d, dd, ddd: the law d(theta) and its derivatives",
+            rhs=sp.collect(sp.expand(J * qdd + half_dJ * qd**2 + G), [qdd, qd]),
+        ),
     ]
     for kind, law in laws.items():
         sub = {ddd: sp.diff(law, theta, 2), dd: sp.diff(law, theta), d: law}
         for name, e in (("J", J), ("half_dJ", half_dJ), ("G", G)):
-            entries.append(Entry(f"{name}_{kind}", sp.Symbol(name), (), f"{kind} pair",
-                                 rhs=sp.simplify(e.xreplace(sub))))
+            entries.append(
+                Entry(f"{name}_{kind}", sp.Symbol(name), (), f"{kind} pair", rhs=sp.simplify(e.xreplace(sub)))
+            )
 
     spec = KernelSpec(
         name="pair_dynamics",
-        doc=("One A-pair with a vertical axis (gravity g along -z): (tau, J, J'/2, G) with "
-             "tau = J theta'' + (J'/2) theta'^2 + G."),
+        doc=(
+            "One A-pair with a vertical axis (gravity g along -z): (tau, J, J'/2, G) with "
+            "tau = J theta'' + (J'/2) theta'^2 + G."
+        ),
         source=SOURCE,
         inputs=[
             Arg("theta", (1,), "joint angle [rad]", (theta,)),
             Arg("qd", (1,), "theta' [rad/s]", (qd,)),
             Arg("qdd", (1,), "theta'' [rad/s^2]", (qdd,)),
             Arg("law", (3,), "(d, d', d'') of the pair at theta", (d, dd, ddd)),
-            Arg("platform", (5,), "platform mass [kg], centre of mass (x, y, z) in the platform frame [m], "
-                "I_zz about the centre of mass [kg m^2]", (m, cx, cy, cz, Izz)),
+            Arg(
+                "platform",
+                (5,),
+                "platform mass [kg], centre of mass (x, y, z) in the platform frame [m], "
+                "I_zz about the centre of mass [kg m^2]",
+                (m, cx, cy, cz, Izz),
+            ),
             Arg("legs", (3,), "(leg mass [kg], r_b [m], r_p [m])", (m_l, r_b, r_p)),
             Arg("g", (1,), "gravitational acceleration [m/s^2] (acting along -z)", (g,)),
         ],
-        outputs=[Arg("terms", (4,), "(tau [N m], J [kg m^2], J'/2 [kg m^2/rad], G [N m])",
-                     exprs=(J * qdd + half_dJ * qd**2 + G, J, half_dJ, G))],
+        outputs=[
+            Arg(
+                "terms",
+                (4,),
+                "(tau [N m], J [kg m^2], J'/2 [kg m^2/rad], G [N m])",
+                exprs=(J * qdd + half_dJ * qd**2 + G, J, half_dJ, G),
+            )
+        ],
     )
     ps = PolynomialSet(
         name="apair_dynamics",
         title="Equation of motion of one A-pair with its six legs",
         source=SOURCE,
-        description=("tau = J(theta) theta'' + (1/2) J'(theta) theta'^2 + G(theta); vertical axis, gravity g "
-                     "along -z; platform mass m, centre of mass c, inertia I; legs: uniform rods of mass m_l."),
+        description=(
+            "tau = J(theta) theta'' + (1/2) J'(theta) theta'^2 + G(theta); vertical axis, gravity g "
+            "along -z; platform mass m, centre of mass c, inertia I; legs: uniform rods of mass m_l."
+        ),
         entries=entries,
     )
     return [ps], [spec], {"J": J, "half_dJ": half_dJ, "G": G}

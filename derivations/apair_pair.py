@@ -10,12 +10,13 @@
 Every closed form that reaches generated code (the pair laws d, d', d'' and the leg end points)
 is taken from these computations, and each step asserts what it claims.
 """
+
 from __future__ import annotations
 
 import mpmath
 import sympy as sp
 
-from .quaternions import Quaternion, rotation, study_symbols, transform_point_homogeneous, translation
+from .quaternions import rotation, study_symbols, transform_point_homogeneous, translation
 from .spec import Arg, Entry, KernelSpec, PolynomialSet
 
 SOURCE = "derivations/apair_pair.py"
@@ -171,13 +172,20 @@ def derive():
         source=SOURCE,
         description=(
             "Sphere condition |R p + t - b|^2 = L^2 of each leg, mapped to the Study parameters "
-            "(x0:x1:x2:x3:y0:y1:y2:y3); quadrics, valid on the Study quadric."),
+            "(x0:x1:x2:x3:y0:y1:y2:y3); quadrics, valid on the Study quadric."
+        ),
         entries=[Entry("study_quadric", sp.expand(x.dot(y)), tuple(gens), "the Study quadric")]
-        + [Entry(f"leg_{k}", g, tuple(gens),
-                 f"{'base vertex' if k < 3 else 'base midpoint'} {k % 3} - "
-                 f"{'platform midpoint' if k < 3 else 'platform vertex'} {k % 3}, "
-                 f"length {'L1' if k < 3 else 'L2'}")
-           for k, g in enumerate(G)],
+        + [
+            Entry(
+                f"leg_{k}",
+                g,
+                tuple(gens),
+                f"{'base vertex' if k < 3 else 'base midpoint'} {k % 3} - "
+                f"{'platform midpoint' if k < 3 else 'platform vertex'} {k % 3}, "
+                f"length {'L1' if k < 3 else 'L2'}",
+            )
+            for k, g in enumerate(G)
+        ],
     )
     motion = PolynomialSet(
         name="apair_motion",
@@ -185,7 +193,8 @@ def derive():
         source=SOURCE,
         description=(
             "On the 3-space x1 = x2 = y1 = y2 = 0 the six leg quadrics reduce to one relation when "
-            "the leg lengths are consistent; a, b are the pair's constants."),
+            "the leg lengths are consistent; a, b are the pair's constants."
+        ),
         entries=[
             Entry("restricted_leg_L1", R[0], (x0, x3, y0, y3), "legs 0, 1, 2 on the 3-space (identical)"),
             Entry("restricted_leg_L2", R[3], (x0, x3, y0, y3), "legs 3, 4, 5 on the 3-space (identical)"),
@@ -197,15 +206,17 @@ def derive():
             Entry("pair_quadric", pair_quadric, (x0, x3, y0, y3), "with x0 y0 + x3 y3 = 0: the pair's curve"),
             Entry("study_quadric", x0 * y0 + x3 * y3, (x0, x3, y0, y3), "the Study quadric on the 3-space"),
             Entry("law", d**2, (), "Rz(theta)Tz(d) put into the pair quadric", rhs=d_sq),
-            Entry("law_general", d, (), f"general pair; |theta| <= acos(-a/b) when a < b", rhs=d_general),
+            Entry("law_general", d, (), "general pair; |theta| <= acos(-a/b) when a < b", rhs=d_general),
             Entry("theta_max_general", sp.Symbol("theta_max"), (), "range of a pair with a < b", rhs=theta_max_general),
             Entry("sinusoidal_L1", L1, (), "a = b", rhs=sinus_L1),
             Entry("sinusoidal_amplitude", h, (), "h = sqrt(2 b)", rhs=h_expr),
             Entry("law_sinusoidal", d, (), "a = b: d(theta) = h cos(theta/2)", rhs=d_sinus),
             Entry("pitch_sinusoidal", sp.Symbol("dd"), (), "d'(theta)", rhs=sp.diff(d_sinus, theta)),
         ]
-        + [Entry(f"rational_{n}", c, (u,), "sinusoidal pair, u = tan(theta/4), times (1+u^2)^2")
-           for n, c in zip(["x0", "x1", "x2", "x3", "y0", "y1", "y2", "y3"], rational)],
+        + [
+            Entry(f"rational_{n}", c, (u,), "sinusoidal pair, u = tan(theta/4), times (1+u^2)^2")
+            for n, c in zip(["x0", "x1", "x2", "x3", "y0", "y1", "y2", "y3"], rational)
+        ],
     )
     facts = {
         "d_squared": d_sq,
@@ -240,11 +251,21 @@ def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
     the range.
     """
     names = {theta: "theta", h: "h", a: "a", b: "b"}
-    inputs = [Arg(names[s], (1,), doc, (s,)) for s, doc in zip(args, {
-        "revolute": ["joint angle [rad]"],
-        "sinusoidal": ["joint angle [rad]", "amplitude h = sqrt(2 r_b r_p) [m]"],
-        "general": ["joint angle [rad], a + b cos(theta) >= 0", "pair constant a [m^2]", "pair constant b = r_b r_p [m^2]"],
-    }[kind])]
+    inputs = [
+        Arg(names[s], (1,), doc, (s,))
+        for s, doc in zip(
+            args,
+            {
+                "revolute": ["joint angle [rad]"],
+                "sinusoidal": ["joint angle [rad]", "amplitude h = sqrt(2 r_b r_p) [m]"],
+                "general": [
+                    "joint angle [rad], a + b cos(theta) >= 0",
+                    "pair constant a [m^2]",
+                    "pair constant b = r_b r_p [m^2]",
+                ],
+            }[kind],
+        )
+    ]
     u = sp.Symbol("u", real=True)
     C, S = sp.Symbol("C_half", real=True), sp.Symbol("S_half", real=True)
 
@@ -264,7 +285,7 @@ def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
         # the same values on the angle route, at a rational point
         vals = {theta: sp.Rational(7, 10), a: sp.Rational(3, 10), b: sp.Rational(11, 10)}
         env = {C: sp.cos(vals[theta] / 2), S: sp.sin(vals[theta] / 2)}
-        env[dsym] = sp.sqrt(vals[a] + vals[b] * (env[C]**2 - env[S]**2))
+        env[dsym] = sp.sqrt(vals[a] + vals[b] * (env[C] ** 2 - env[S] ** 2))
         for e, ref in zip(outs, derivs):
             assert abs(sp.N(e.subs(env).subs(vals) - ref.subs(vals), 30)) < 1e-25
     elif kind == "revolute":
@@ -273,12 +294,20 @@ def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
         outs = [in_half(e) for e in derivs]
     return KernelSpec(
         name=f"law_{kind}",
-        doc=(f"The {kind} pair's law values at theta: cos(theta/2), sin(theta/2), d(theta) and its first two "
-             "derivatives, as the chain kernels take them."),
+        doc=(
+            f"The {kind} pair's law values at theta: cos(theta/2), sin(theta/2), d(theta) and its first two "
+            "derivatives, as the chain kernels take them."
+        ),
         source=SOURCE,
         inputs=inputs,
-        outputs=[Arg("law", (5,), "(cos(theta/2), sin(theta/2), d [m], d' [m/rad], d'' [m/rad^2])",
-                     exprs=(C, S) + tuple(outs))],
+        outputs=[
+            Arg(
+                "law",
+                (5,),
+                "(cos(theta/2), sin(theta/2), d [m], d' [m/rad], d'' [m/rad^2])",
+                exprs=(C, S) + tuple(outs),
+            )
+        ],
         steps=steps,
     )
 
@@ -291,17 +320,30 @@ def design_specs(a_expr, b_expr, L2_sq, sinus_L1, h_expr) -> list[KernelSpec]:
         KernelSpec(
             name="design_sinusoidal",
             doc="Constants of the sinusoidal pair (a = b) with the given radii.",
-            source=SOURCE, inputs=[radii],
-            outputs=[Arg("design", (5,), "(L1 [m], L2 [m], a [m^2], b [m^2], h [m])", exprs=(
-                sinus_L1, sp.sqrt(sp.factor(L2_sq.subs(sin_sub))), a_expr.subs(sin_sub), b_expr, h_expr))],
+            source=SOURCE,
+            inputs=[radii],
+            outputs=[
+                Arg(
+                    "design",
+                    (5,),
+                    "(L1 [m], L2 [m], a [m^2], b [m^2], h [m])",
+                    exprs=(sinus_L1, sp.sqrt(sp.factor(L2_sq.subs(sin_sub))), a_expr.subs(sin_sub), b_expr, h_expr),
+                )
+            ],
         ),
         KernelSpec(
             name="design_general",
             doc="Constants of the general pair with leg length L1; L2^2 <= 0 or a + b <= 0 admit no pose.",
             source=SOURCE,
             inputs=[radii, Arg("leg_length", (1,), "L1, the base-vertex legs' length [m]", (L1,))],
-            outputs=[Arg("design", (4,), "(L2^2 [m^2], a [m^2], b [m^2], a + b [m^2])", exprs=(
-                L2_sq, a_expr, b_expr, a_expr + b_expr))],
+            outputs=[
+                Arg(
+                    "design",
+                    (4,),
+                    "(L2^2 [m^2], a [m^2], b [m^2], a + b [m^2])",
+                    exprs=(L2_sq, a_expr, b_expr, a_expr + b_expr),
+                )
+            ],
         ),
     ]
 

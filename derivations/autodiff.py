@@ -4,6 +4,7 @@ A derivation written as steps s_k = e_k(inputs, earlier steps) is differentiated
 direction by the chain rule, step by step: ds_k = Σ_v ∂e_k/∂v · dv. The derivative is itself a list
 of small steps, so differentiating a large recursion never builds the expanded expression.
 """
+
 from __future__ import annotations
 
 import sympy as sp

@@ -25,6 +25,7 @@ and column i of M the extra force (m/6) X S_i on body i−1.
 - `check_bias`: at generation time, the recursion equals the Lagrangian Ṁθ' − ∇(T − V) with
   T = ½ θ'ᵀMθ', the gravity torques equal ∂V/∂θ, and the recursion at θ' = 0 gives M θ''.
 """
+
 from __future__ import annotations
 
 import sympy as sp
@@ -32,8 +33,19 @@ import sympy as sp
 from . import apair_pair
 from .autodiff import directional, gradient
 from .chain_kinematics import MAX_N, _Recorder, chain_inputs, joint_trig
-from .spatial import (Namer, add_inertia, apply_inertia, cross_force, cross_motion, force_to_parent,
-                      inertia_to_parent, motion_to_child, point_mass_inertia, rotation, skew)
+from .spatial import (
+    Namer,
+    add_inertia,
+    apply_inertia,
+    cross_force,
+    cross_motion,
+    force_to_parent,
+    inertia_to_parent,
+    motion_to_child,
+    point_mass_inertia,
+    rotation,
+    skew,
+)
 from .spec import Arg, Call, KernelSpec
 
 SOURCE = "derivations/chain_dynamics.py"
@@ -79,11 +91,21 @@ def dynamics_inputs(n: int):
         "qd": Arg("qd", (n,), "joint velocities theta'_i [rad/s]", tuple(j["qd"] for j in J)),
         "qdd": Arg("qdd", (n,), "joint accelerations theta''_i [rad/s^2]", tuple(j["qdd"] for j in J)),
         "dh": dh,
-        "links": Arg("links", (n, 10), "per link (mass [kg], com [m] in frame i (3), inertia about the com in "
-                     "frame i: Ixx, Iyy, Izz, Ixy, Ixz, Iyz [kg m^2])", tuple(j[k] for j in J for k in LINK_FIELDS),
-                     design=True),
-        "legs": Arg("legs", (n, 3), "per pair (leg mass [kg], r_b [m], r_p [m]); zeros for an R-pair",
-                    tuple(j[k] for j in J for k in LEG_FIELDS), design=True),
+        "links": Arg(
+            "links",
+            (n, 10),
+            "per link (mass [kg], com [m] in frame i (3), inertia about the com in "
+            "frame i: Ixx, Iyy, Izz, Ixy, Ixz, Iyz [kg m^2])",
+            tuple(j[k] for j in J for k in LINK_FIELDS),
+            design=True,
+        ),
+        "legs": Arg(
+            "legs",
+            (n, 3),
+            "per pair (leg mass [kg], r_b [m], r_p [m]); zeros for an R-pair",
+            tuple(j[k] for j in J for k in LEG_FIELDS),
+            design=True,
+        ),
         "gravity": Arg("gravity", (3,), "gravity vector in the base frame [m/s^2]", gvec, design=True),
     }
     return args, J, sp.Matrix(gvec)
@@ -120,7 +142,9 @@ class Assembly:
         self.bodies, self.weights = [], []
         for i, j in enumerate(J, start=1):
             c = sp.Matrix([j["cx"], j["cy"], j["cz"]])
-            Ic = sp.Matrix([[j["Ixx"], j["Ixy"], j["Ixz"]], [j["Ixy"], j["Iyy"], j["Iyz"]], [j["Ixz"], j["Iyz"], j["Izz"]]])
+            Ic = sp.Matrix(
+                [[j["Ixx"], j["Ixy"], j["Ixz"]], [j["Ixy"], j["Iyy"], j["Iyz"]], [j["Ixz"], j["Iyz"], j["Izz"]]]
+            )
             link = (j["m"], j["m"] * c, Ic + j["m"] * ((c.T * c)[0] * sp.eye(3) - c * c.T))
             parts_i, weight_i = [link], [(j["m"], j["m"] * c, None)]
             if i < n:
@@ -129,8 +153,9 @@ class Assembly:
                 weight_i.append((3 * nxt["ml"], ZERO3, None))
             in_frame = add_inertia(*parts_i)
             body = inertia_to_parent(self.outer[i], in_frame, nm, "Ib")
-            plat = inertia_to_parent([("tz", -j["c"])], point_mass_inertia(2 * j["ml"], ZERO3, j["ml"] / 3 * local(Spp, j)),
-                                     nm, "Ip")
+            plat = inertia_to_parent(
+                [("tz", -j["c"])], point_mass_inertia(2 * j["ml"], ZERO3, j["ml"] / 3 * local(Spp, j)), nm, "Ip"
+            )
             self.bodies.append(self._named(nm, "B", add_inertia(body, plat)))
             wm = sum((w[0] for w in weight_i), sp.S(0))
             wh = sum((w[1] for w in weight_i), sp.zeros(3, 1))
@@ -151,7 +176,9 @@ class Assembly:
         for i in range(n, 1, -1):
             IB = inertia_to_parent(self.inner[i], Ic[i], nm, "Ci")
             IB = self._named(nm, "CB", add_inertia(IB, self.coupling[i]))
-            Ic[i - 1] = self._named(nm, "Cc", add_inertia(self.bodies[i - 2], inertia_to_parent(self.outer[i - 1], IB, nm, "Co")))
+            Ic[i - 1] = self._named(
+                nm, "Cc", add_inertia(self.bodies[i - 2], inertia_to_parent(self.outer[i - 1], IB, nm, "Co"))
+            )
         M = sp.zeros(n, n)
         for i in range(1, n + 1):
             F = [nm.vec("Fn", x) for x in apply_inertia(Ic[i], self.S[i - 1])]
@@ -237,8 +264,10 @@ def rnea(asm: Assembly, qd, qdd, gravity: bool, prefix: str):
         S = asm.S[i - 1]
         VB = (nm.vec("Vw", V[0] + S[0] * qd[i - 1]), nm.vec("Vv", V[1] + S[1] * qd[i - 1]))
         cm = cross_motion(V, S)
-        AB = (nm.vec("Aw", A[0] + S[0] * qdd[i - 1] + cm[0] * qd[i - 1]),
-              nm.vec("Av", A[1] + S[1] * qdd[i - 1] + cm[1] * qd[i - 1] + j["ddd"] * qd[i - 1] ** 2 * EZ))
+        AB = (
+            nm.vec("Aw", A[0] + S[0] * qdd[i - 1] + cm[0] * qd[i - 1]),
+            nm.vec("Av", A[1] + S[1] * qdd[i - 1] + cm[1] * qd[i - 1] + j["ddd"] * qd[i - 1] ** 2 * EZ),
+        )
         # the legs of pair i, from the accelerations of their ends' bodies in B_i
         ml, K = j["ml"], asm.K[i]
         Sb = 6 * j["d"] * EZ
@@ -355,9 +384,12 @@ def check_bias(n: int, samples: int = 2, digits: int = 30) -> float:
                 env[j["ch"]], env[j["sh"]] = mpmath.cos(th / 2), mpmath.sin(th / 2)
             for sym, e in steps:
                 env[sym] = sp.lambdify(sorted(e.free_symbols, key=str), e, "mpmath")(
-                    *[env[v] for v in sorted(e.free_symbols, key=str)])
+                    *[env[v] for v in sorted(e.free_symbols, key=str)]
+                )
             for d in diffs:
-                val = sp.lambdify(sorted(d.free_symbols, key=str), d, "mpmath")(*[env[v] for v in sorted(d.free_symbols, key=str)])
+                val = sp.lambdify(sorted(d.free_symbols, key=str), d, "mpmath")(
+                    *[env[v] for v in sorted(d.free_symbols, key=str)]
+                )
                 worst = max(worst, abs(val))
     assert worst < mpmath.mpf(10) ** (-(digits - 8)), f"RNEA and Lagrangian disagree for n={n}: {worst}"
     return float(worst)
@@ -376,7 +408,9 @@ def cholesky_solve(M: sp.Matrix, rhs: list, prefix: str):
         L[j, j] = rec.name(f"{prefix}L{j}{j}", sp.sqrt(M[j, j] - sum((L[j, k] ** 2 for k in range(j)), sp.S(0))))
         inv = rec.name(f"{prefix}iL{j}", 1 / L[j, j])
         for i in range(j + 1, n):
-            L[i, j] = rec.name(f"{prefix}L{i}{j}", (M[i, j] - sum((L[i, k] * L[j, k] for k in range(j)), sp.S(0))) * inv)
+            L[i, j] = rec.name(
+                f"{prefix}L{i}{j}", (M[i, j] - sum((L[i, k] * L[j, k] for k in range(j)), sp.S(0))) * inv
+            )
         L[j, j] = inv  # below, only 1/L_jj is needed
     y = [None] * n
     for i in range(n):
@@ -401,12 +435,22 @@ def specs_for(n: int) -> list[KernelSpec]:
     c_steps, C = christoffel(asm)
     kin = ("law", "dh")
     body = ("links", "legs")
-    mass = KernelSpec(f"mass_matrix{n}", f"Mass matrix M(theta) ({n} x {n}) of a {n}-joint chain, legs included.",
-                      SOURCE, asm.inputs(*kin, *body), [Arg("M", (n, n), "mass matrix, row-major", exprs=tuple(asm.M))],
-                      base)
-    inverse = KernelSpec(f"inverse_dynamics{n}", f"Joint torques tau = M theta'' + C theta' + g ({n}) of a {n}-joint chain.",
-                         SOURCE, asm.inputs("law", "qd", "qdd", "dh", *body, "gravity"),
-                         [Arg("tau", (n,), "joint torques [N m]", exprs=tuple(tau))], base + i_steps)
+    mass = KernelSpec(
+        f"mass_matrix{n}",
+        f"Mass matrix M(theta) ({n} x {n}) of a {n}-joint chain, legs included.",
+        SOURCE,
+        asm.inputs(*kin, *body),
+        [Arg("M", (n, n), "mass matrix, row-major", exprs=tuple(asm.M))],
+        base,
+    )
+    inverse = KernelSpec(
+        f"inverse_dynamics{n}",
+        f"Joint torques tau = M theta'' + C theta' + g ({n}) of a {n}-joint chain.",
+        SOURCE,
+        asm.inputs("law", "qd", "qdd", "dh", *body, "gravity"),
+        [Arg("tau", (n,), "joint torques [N m]", exprs=tuple(tau))],
+        base + i_steps,
+    )
     M_r = sp.Matrix(n, n, [sp.Symbol(f"rM{k}", real=True) for k in range(n * n)])
     b_r = [sp.Symbol(f"rb{k}", real=True) for k in range(n)]
     call_M = lambda *names: Call(mass, names, tuple(M_r))
@@ -418,27 +462,50 @@ def specs_for(n: int) -> list[KernelSpec]:
     T = sp.expand((qdm.T * M_r * qdm)[0] / 2)
     return [
         mass,
-        KernelSpec(f"gravity{n}", f"Gravity torques g(theta) = dV/dtheta ({n}) of a {n}-joint chain.",
-                   SOURCE, asm.inputs(*kin, *body, "gravity"), [Arg("g", (n,), "gravity torques [N m]", exprs=tuple(g))],
-                   base + g_steps),
-        KernelSpec(f"coriolis{n}", f"Coriolis matrix C(theta, theta') ({n} x {n}, Christoffel form) of a {n}-joint chain.",
-                   SOURCE, asm.inputs("law", "qd", "dh", *body),
-                   [Arg("C", (n, n), "C such that dM/dt - 2C is skew-symmetric, row-major", exprs=tuple(C))],
-                   base + c_steps),
-        KernelSpec(f"bias{n}", f"Bias C(theta, theta') theta' + g(theta) ({n}) of a {n}-joint chain.",
-                   SOURCE, asm.inputs("law", "qd", "dh", *body, "gravity"),
-                   [Arg("bias", (n,), "bias torques [N m]", exprs=tuple(b_r))],
-                   calls=[Call(inverse, ("law", "qd", None, "dh", "links", "legs", "gravity"), tuple(b_r))]),
+        KernelSpec(
+            f"gravity{n}",
+            f"Gravity torques g(theta) = dV/dtheta ({n}) of a {n}-joint chain.",
+            SOURCE,
+            asm.inputs(*kin, *body, "gravity"),
+            [Arg("g", (n,), "gravity torques [N m]", exprs=tuple(g))],
+            base + g_steps,
+        ),
+        KernelSpec(
+            f"coriolis{n}",
+            f"Coriolis matrix C(theta, theta') ({n} x {n}, Christoffel form) of a {n}-joint chain.",
+            SOURCE,
+            asm.inputs("law", "qd", "dh", *body),
+            [Arg("C", (n, n), "C such that dM/dt - 2C is skew-symmetric, row-major", exprs=tuple(C))],
+            base + c_steps,
+        ),
+        KernelSpec(
+            f"bias{n}",
+            f"Bias C(theta, theta') theta' + g(theta) ({n}) of a {n}-joint chain.",
+            SOURCE,
+            asm.inputs("law", "qd", "dh", *body, "gravity"),
+            [Arg("bias", (n,), "bias torques [N m]", exprs=tuple(b_r))],
+            calls=[Call(inverse, ("law", "qd", None, "dh", "links", "legs", "gravity"), tuple(b_r))],
+        ),
         inverse,
-        KernelSpec(f"forward_dynamics{n}", f"Joint accelerations theta'' = M^-1 (tau - C theta' - g) ({n}) of a "
-                   f"{n}-joint chain, by Cholesky (NaN where M is not positive definite).",
-                   SOURCE, asm.inputs("law", "qd") + [tau_arg] + asm.inputs("dh", *body, "gravity"),
-                   [Arg("qdd", (n,), "joint accelerations [rad/s^2]", exprs=tuple(qdd_fd))], f_steps,
-                   calls=[call_M("law", "dh", "links", "legs"), call_bias]),
-        KernelSpec(f"energy{n}", f"Kinetic and potential energy (T, V) of a {n}-joint chain.",
-                   SOURCE, asm.inputs("law", "qd", "dh", *body, "gravity"),
-                   [Arg("energy", (2,), "(T, V) [J]", exprs=(T, asm.V))], base + asm.vrec.steps,
-                   calls=[call_M("law", "dh", "links", "legs")]),
+        KernelSpec(
+            f"forward_dynamics{n}",
+            f"Joint accelerations theta'' = M^-1 (tau - C theta' - g) ({n}) of a "
+            f"{n}-joint chain, by Cholesky (NaN where M is not positive definite).",
+            SOURCE,
+            asm.inputs("law", "qd") + [tau_arg] + asm.inputs("dh", *body, "gravity"),
+            [Arg("qdd", (n,), "joint accelerations [rad/s^2]", exprs=tuple(qdd_fd))],
+            f_steps,
+            calls=[call_M("law", "dh", "links", "legs"), call_bias],
+        ),
+        KernelSpec(
+            f"energy{n}",
+            f"Kinetic and potential energy (T, V) of a {n}-joint chain.",
+            SOURCE,
+            asm.inputs("law", "qd", "dh", *body, "gravity"),
+            [Arg("energy", (2,), "(T, V) [J]", exprs=(T, asm.V))],
+            base + asm.vrec.steps,
+            calls=[call_M("law", "dh", "links", "legs")],
+        ),
     ]
 
 

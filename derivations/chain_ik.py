@@ -26,6 +26,7 @@ imaginary parts (`split_complex`), so the one emitter prints ordinary C and NumP
 `check_system` compares F, ∂F/∂θ and Fs with an independent route (the 4×4 DH product in mpmath,
 the quaternion from the rotation matrix, complex central differences) at random complex points.
 """
+
 from __future__ import annotations
 
 import random
@@ -84,7 +85,7 @@ def split_complex(steps, outputs, parts: dict) -> tuple[list, list]:
                 inv = sp.Symbol(f"{p.base.name}_inv")
                 if inv not in parts:
                     parts[inv] = _reciprocal(*parts[p.base], rec, inv.name)
-                subs[p] = inv ** -p.exp
+                subs[p] = inv**-p.exp
         expr = expr.xreplace(subs)
         return _parts(expr.xreplace({s: re + I * im for s, (re, im) in parts.items()}))
 
@@ -108,7 +109,11 @@ def _complex_arg(name: str, shape, doc: str, labels, design: bool = False):
         parts[z] = (re, im)
         symbols += [re, im]
         placeholders.append(z)
-    return Arg(name, tuple(shape) + (2,), doc + " (real, imaginary)", tuple(symbols), design=design), parts, placeholders
+    return (
+        Arg(name, tuple(shape) + (2,), doc + " (real, imaginary)", tuple(symbols), design=design),
+        parts,
+        placeholders,
+    )
 
 
 def _complex_out(name: str, shape, doc: str, pairs) -> Arg:
@@ -145,9 +150,13 @@ def law_spec(kind: str) -> KernelSpec:
     steps, outs = split_complex([], exprs, parts)
     return KernelSpec(
         name=f"ik_law_{kind}",
-        doc=(f"The {kind} pair's law at a complex angle, given as v = exp(i theta/2): cos(theta/2), "
-             "sin(theta/2), d and d'."),
-        source=SOURCE, inputs=inputs, steps=steps,
+        doc=(
+            f"The {kind} pair's law at a complex angle, given as v = exp(i theta/2): cos(theta/2), "
+            "sin(theta/2), d and d'."
+        ),
+        source=SOURCE,
+        inputs=inputs,
+        steps=steps,
         outputs=[_complex_out("law", (4,), "(cos(theta/2), sin(theta/2), d [m], d' [m/rad])", outs)],
     )
 
@@ -199,12 +208,21 @@ def _residual(T: sp.Matrix, x: Quaternion, tsyms) -> list[sp.Expr]:
 def system_spec(n: int) -> KernelSpec:
     """ik_system{n}: F, ∂F/∂θ and the derivative along a direction of poses (module docstring)."""
     labels = [f"{f}_{i}" for i in range(1, n + 1) for f in LAW_FIELDS]
-    law_arg, parts, law_syms = _complex_arg("law", (n, 4), "per joint (cos(theta_i/2), sin(theta_i/2), d_i [m], "
-                                            "d'_i [m/rad])", labels)
-    tgt_arg, tparts, tsyms = _complex_arg("target", (7,), "pose (t [m], q): translation and rotation quaternion "
-                                          "up to scale", ["t1", "t2", "t3", "q0", "q1", "q2", "q3"])
-    dir_arg, dparts, dsyms = _complex_arg("direction", (7,), "a direction (dt, dq) in the same coordinates",
-                                          ["dt1", "dt2", "dt3", "dq0", "dq1", "dq2", "dq3"])
+    law_arg, parts, law_syms = _complex_arg(
+        "law", (n, 4), "per joint (cos(theta_i/2), sin(theta_i/2), d_i [m], d'_i [m/rad])", labels
+    )
+    tgt_arg, tparts, tsyms = _complex_arg(
+        "target",
+        (7,),
+        "pose (t [m], q): translation and rotation quaternion up to scale",
+        ["t1", "t2", "t3", "q0", "q1", "q2", "q3"],
+    )
+    dir_arg, dparts, dsyms = _complex_arg(
+        "direction",
+        (7,),
+        "a direction (dt, dq) in the same coordinates",
+        ["dt1", "dt2", "dt3", "dq0", "dq1", "dq2", "dq3"],
+    )
     parts.update(tparts)
     parts.update(dparts)
     J = []
@@ -212,8 +230,13 @@ def system_spec(n: int) -> KernelSpec:
         j = joint_symbols(i)
         j.update({f: law_syms[4 * (i - 1) + k] for k, f in enumerate(LAW_FIELDS)})
         J.append(j)
-    dh_arg = Arg("dh", (n, 4), "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])",
-                 tuple(j[k] for j in J for k in ("a", "alpha", "c", "phi")), design=True)
+    dh_arg = Arg(
+        "dh",
+        (n, 4),
+        "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])",
+        tuple(j[k] for j in J for k in ("a", "alpha", "c", "phi")),
+        design=True,
+    )
     rec = _Recorder()
     F = frames(n, J, rec)
     Jm = screw_jacobian(F, J)
@@ -225,8 +248,12 @@ def system_spec(n: int) -> KernelSpec:
     for c in range(3):
         e = [0, 0, 0]
         e[c] = 1
-        G.append([rec.name(f"G{c}_{r}", sp.expand(v / 2)) for r, v in
-                  enumerate((Quaternion(*q).conj() * Quaternion.pure(e) * x).vec())])
+        G.append(
+            [
+                rec.name(f"G{c}_{r}", sp.expand(v / 2))
+                for r, v in enumerate((Quaternion(*q).conj() * Quaternion.pure(e) * x).vec())
+            ]
+        )
     F_out = _residual(T, x, tsyms)
     J_out = []
     for r in range(6):
@@ -237,13 +264,19 @@ def system_spec(n: int) -> KernelSpec:
     nF, nJ = 6, 6 * n
     return KernelSpec(
         name=f"ik_system{n}",
-        doc=(f"The inverse-kinematics homotopy system of a {n}-joint chain at complex law values and a complex "
-             "pose (t, q): F = [o - t; vec(conj(q) x)] (zero exactly where fk = (t, q)), dF/dtheta (6 x n) and "
-             "the derivative of F along a direction (dt, dq) of poses."),
-        source=SOURCE, inputs=[law_arg, tgt_arg, dir_arg, dh_arg], steps=steps,
-        outputs=[_complex_out("F", (6,), "residual", outs[:nF]),
-                 _complex_out("dF", (6, n), "derivative in the joint angles, row-major", outs[nF:nF + nJ]),
-                 _complex_out("dFs", (6,), "derivative along the direction", outs[nF + nJ:])],
+        doc=(
+            f"The inverse-kinematics homotopy system of a {n}-joint chain at complex law values and a complex "
+            "pose (t, q): F = [o - t; vec(conj(q) x)] (zero exactly where fk = (t, q)), dF/dtheta (6 x n) and "
+            "the derivative of F along a direction (dt, dq) of poses."
+        ),
+        source=SOURCE,
+        inputs=[law_arg, tgt_arg, dir_arg, dh_arg],
+        steps=steps,
+        outputs=[
+            _complex_out("F", (6,), "residual", outs[:nF]),
+            _complex_out("dF", (6, n), "derivative in the joint angles, row-major", outs[nF : nF + nJ]),
+            _complex_out("dFs", (6,), "derivative along the direction", outs[nF + nJ :]),
+        ],
     )
 
 
@@ -257,13 +290,18 @@ def residual_spec(n: int) -> KernelSpec:
     far below 1 still converges), so that such paths are tracked and their endpoints refined."""
     zr, law_r = law_in_variable("revolute")
     zs, law_s = law_in_variable("sinusoidal")
-    assert all(sp.expand(a - b.subs({h: 0, zs: zr})) == 0 for a, b in zip(law_r, law_s)), \
+    assert all(sp.expand(a - b.subs({h: 0, zs: zr})) == 0 for a, b in zip(law_r, law_s)), (
         "an R-pair's law is the sinusoidal law with h = 0"
+    )
     v_arg, parts, vsyms = _complex_arg("v", (n,), "per joint exp(i theta_i/2)", [f"v_{i}" for i in range(1, n + 1)])
     hs = tuple(sp.Symbol(f"h_{i}", real=True) for i in range(1, n + 1))
     h_arg = Arg("h", (n,), "per joint the amplitude h_i of a sinusoidal A-pair, 0 for an R-pair [m]", hs, design=True)
-    tgt_arg, tparts, tsyms = _complex_arg("target", (7,), "pose (t [m], q): translation and rotation quaternion "
-                                          "up to scale", ["t1", "t2", "t3", "q0", "q1", "q2", "q3"])
+    tgt_arg, tparts, tsyms = _complex_arg(
+        "target",
+        (7,),
+        "pose (t [m], q): translation and rotation quaternion up to scale",
+        ["t1", "t2", "t3", "q0", "q1", "q2", "q3"],
+    )
     parts.update(tparts)
     rec = _Recorder()
     J = []
@@ -273,16 +311,26 @@ def residual_spec(n: int) -> KernelSpec:
         for f, e in zip(("ch", "sh", "d"), law_s):
             j[f] = rec.name(f"L{i}_{f}", sp.expand(e.xreplace(sub)))
         J.append(j)
-    dh_arg = Arg("dh", (n, 4), "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])",
-                 tuple(j[k] for j in J for k in ("a", "alpha", "c", "phi")), design=True)
+    dh_arg = Arg(
+        "dh",
+        (n, 4),
+        "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])",
+        tuple(j[k] for j in J for k in ("a", "alpha", "c", "phi")),
+        design=True,
+    )
     T = frames(n, J, rec)[n]
     steps, outs = split_complex(rec.steps, _residual(T, _rotation(J, rec), tsyms), parts)
     return KernelSpec(
         name=f"ik_residual{n}",
-        doc=(f"The residual F of ik_system{n} at z_i = exp(i theta_i/2) (the laws included), also in extended "
-             "precision for the tracker's corrector far out in the complex."),
-        source=SOURCE, inputs=[v_arg, h_arg, tgt_arg, dh_arg], steps=steps,
-        outputs=[_complex_out("F", (6,), "residual", outs)], wide=True,
+        doc=(
+            f"The residual F of ik_system{n} at z_i = exp(i theta_i/2) (the laws included), also in extended "
+            "precision for the tracker's corrector far out in the complex."
+        ),
+        source=SOURCE,
+        inputs=[v_arg, h_arg, tgt_arg, dh_arg],
+        steps=steps,
+        outputs=[_complex_out("F", (6,), "residual", outs)],
+        wide=True,
     )
 
 
@@ -291,21 +339,28 @@ def _mp_dh(theta_i, d_i, a, alpha, c, phi):
     """A_i = Rz(θ + φ)·Tz(c + d)·Tx(a)·Rx(α) (docs/conventions.md §3) as an mpmath matrix."""
     ct, st = mpmath.cos(theta_i + phi), mpmath.sin(theta_i + phi)
     ca, sa = mpmath.cos(alpha), mpmath.sin(alpha)
-    return mpmath.matrix([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
-                          [0, sa, ca, c + d_i], [0, 0, 0, 1]])
+    return mpmath.matrix(
+        [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, c + d_i], [0, 0, 0, 1]]
+    )
 
 
 def _mp_qmul(x, y):
-    return [x[0] * y[0] - x[1] * y[1] - x[2] * y[2] - x[3] * y[3],
-            x[0] * y[1] + x[1] * y[0] + x[2] * y[3] - x[3] * y[2],
-            x[0] * y[2] - x[1] * y[3] + x[2] * y[0] + x[3] * y[1],
-            x[0] * y[3] + x[1] * y[2] - x[2] * y[1] + x[3] * y[0]]
+    return [
+        x[0] * y[0] - x[1] * y[1] - x[2] * y[2] - x[3] * y[3],
+        x[0] * y[1] + x[1] * y[0] + x[2] * y[3] - x[3] * y[2],
+        x[0] * y[2] - x[1] * y[3] + x[2] * y[0] + x[3] * y[1],
+        x[0] * y[3] + x[1] * y[2] - x[2] * y[1] + x[3] * y[0],
+    ]
 
 
 def _mp_quaternion(R):
     """The unit quaternion of a (complex) rotation matrix, sign fixed by its largest component."""
-    w = [1 + R[0, 0] + R[1, 1] + R[2, 2], 1 + R[0, 0] - R[1, 1] - R[2, 2], 1 - R[0, 0] + R[1, 1] - R[2, 2],
-         1 - R[0, 0] - R[1, 1] + R[2, 2]]
+    w = [
+        1 + R[0, 0] + R[1, 1] + R[2, 2],
+        1 + R[0, 0] - R[1, 1] - R[2, 2],
+        1 - R[0, 0] + R[1, 1] - R[2, 2],
+        1 - R[0, 0] - R[1, 1] + R[2, 2],
+    ]
     k = max(range(4), key=lambda m: abs(w[m]))
     s = mpmath.sqrt(w[k]) * 2
     if k == 0:
@@ -352,8 +407,11 @@ def _evaluate(spec: KernelSpec, values: dict, dh, digits: int):
     flat = [mpmath.mpmathify(sp.N(e.xreplace(env), digits)) for a in spec.outputs for e in a.exprs]
     n = spec.inputs[-1].shape[0]
     # the kernel's quaternion sign: the half-angle product's (the matrix route's is aligned with it)
-    x = [mpmath.mpmathify(sp.N(sp.Symbol(f"X{n}_{k}_re", real=True).xreplace(env), digits))
-         + 1j * mpmath.mpmathify(sp.N(sp.Symbol(f"X{n}_{k}_im", real=True).xreplace(env), digits)) for k in range(4)]
+    x = [
+        mpmath.mpmathify(sp.N(sp.Symbol(f"X{n}_{k}_re", real=True).xreplace(env), digits))
+        + 1j * mpmath.mpmathify(sp.N(sp.Symbol(f"X{n}_{k}_im", real=True).xreplace(env), digits))
+        for k in range(4)
+    ]
     return [flat[2 * k] + 1j * flat[2 * k + 1] for k in range(len(flat) // 2)], x
 
 
@@ -365,11 +423,19 @@ def check_residual(n: int = 3, digits: int = 30) -> float:
     with mpmath.workdps(digits):
         th = [mpmath.mpc(rng.uniform(-3, 3), rng.uniform(-2, 2)) for _ in range(n)]
         hs = [rng.uniform(0.2, 1.0) if i % 2 == 0 else 0.0 for i in range(n)]
-        dh = [[mpmath.mpf(rng.uniform(-1, 1)), mpmath.mpf(rng.uniform(-2, 2)), mpmath.mpf(rng.uniform(-1, 1)),
-               mpmath.mpf(rng.uniform(-2, 2))] for _ in range(n)]
+        dh = [
+            [
+                mpmath.mpf(rng.uniform(-1, 1)),
+                mpmath.mpf(rng.uniform(-2, 2)),
+                mpmath.mpf(rng.uniform(-1, 1)),
+                mpmath.mpf(rng.uniform(-2, 2)),
+            ]
+            for _ in range(n)
+        ]
         target = [mpmath.mpc(rng.uniform(-1, 1), rng.uniform(-1, 1)) for _ in range(7)]
-        got, x_kernel = _evaluate(spec, {"v": [mpmath.exp(1j * t / 2) for t in th], "h": hs, "target": target},
-                                  dh, digits)
+        got, x_kernel = _evaluate(
+            spec, {"v": [mpmath.exp(1j * t / 2) for t in th], "h": hs, "target": target}, dh, digits
+        )
         F, _ = _mp_system(th, hs, dh, target, x_kernel)
         worst = max(abs(g - f) for g, f in zip(got, F))
     assert worst < 1e-15, f"ik_residual{n} differs from the DH route by {worst}"
@@ -389,11 +455,21 @@ def check_system(n: int = 3, digits: int = 30) -> float:
     with mpmath.workdps(digits):
         th = [cplx() for _ in range(n)]
         hs = [rng.uniform(0.2, 1.0) if i % 2 == 0 else 0.0 for i in range(n)]  # A-, R-, A-pair, ...
-        dh = [[mpmath.mpf(rng.uniform(-1, 1)), mpmath.mpf(rng.uniform(-2, 2)), mpmath.mpf(rng.uniform(-1, 1)),
-               mpmath.mpf(rng.uniform(-2, 2))] for _ in range(n)]
+        dh = [
+            [
+                mpmath.mpf(rng.uniform(-1, 1)),
+                mpmath.mpf(rng.uniform(-2, 2)),
+                mpmath.mpf(rng.uniform(-1, 1)),
+                mpmath.mpf(rng.uniform(-2, 2)),
+            ]
+            for _ in range(n)
+        ]
         target, direction = [cplx() for _ in range(7)], [cplx() for _ in range(7)]
-        law = [x for t, hh in zip(th, hs) for x in (mpmath.cos(t / 2), mpmath.sin(t / 2), hh * mpmath.cos(t / 2),
-                                                      -hh / 2 * mpmath.sin(t / 2))]
+        law = [
+            x
+            for t, hh in zip(th, hs)
+            for x in (mpmath.cos(t / 2), mpmath.sin(t / 2), hh * mpmath.cos(t / 2), -hh / 2 * mpmath.sin(t / 2))
+        ]
         got, x_kernel = _evaluate(spec, {"law": law, "target": target, "direction": direction}, dh, digits)
         F, x = _mp_system(th, hs, dh, target, x_kernel)
         worst = max(abs(a - b) for a, b in zip(x, x_kernel))
@@ -407,7 +483,7 @@ def check_system(n: int = 3, digits: int = 30) -> float:
             worst = max([worst] + [abs(got[6 + r * n + i] - (Fu[r] - Fd[r]) / (2 * eps)) for r in range(6)])
         shifted = [a + b for a, b in zip(target, direction)]
         Fs = [a - b for a, b in zip(_mp_system(th, hs, dh, shifted, x)[0], F)]
-        worst = max([worst] + [abs(g - f) for g, f in zip(got[6 + 6 * n:], Fs)])
+        worst = max([worst] + [abs(g - f) for g, f in zip(got[6 + 6 * n :], Fs)])
     assert worst < 1e-15, f"ik_system{n} differs from the DH route by {worst}"
     return float(worst)
 

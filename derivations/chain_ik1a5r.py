@@ -25,6 +25,7 @@ eigenvalues at ±i.
 `check_equations` verifies every split at random 1A5R poses in 40-digit arithmetic through the
 DH product of docs/conventions.md §3 (mpmath), independently of the symbolic route.
 """
+
 from __future__ import annotations
 
 import random
@@ -51,15 +52,19 @@ def transform(R, t, F) -> list:
     """f(g·(l, p)) from F = f(l, p) for g = (R, t) (R a rotation): l → R l, p → R p + t, so
     p·p → p·p + 2 t·Rp + t·t, p·l → p·l + t·Rl, p × l → R(p × l) + t × Rl and
     (p·p) l − 2 (p·l) p → R[…] − 2 t × R(p × l) + (t·t) Rl − 2 (p·l) t − 2 (t·Rl) t."""
-    rot = lambda v: [sum(R[r][c] * v[c] for c in range(3)) for r in range(3)]  # noqa: E731
-    dot = lambda x, y: sum(a * b for a, b in zip(x, y))  # noqa: E731
-    cross = lambda x, y: [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]]  # noqa: E731
+    rot = lambda v: [sum(R[r][c] * v[c] for c in range(3)) for r in range(3)]
+    dot = lambda x, y: sum(a * b for a, b in zip(x, y))
+    cross = lambda x, y: [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]]
     l, p, pp, pl, cr, f4 = F[0:3], F[3:6], F[6], F[7], F[8:11], F[11:14]
     Rl, Rp, Rcr, Rf4 = rot(l), rot(p), rot(cr), rot(f4)
     tt, tRl = dot(t, t), dot(t, Rl)
-    return (Rl + [x + y for x, y in zip(Rp, t)] + [pp + 2 * dot(t, Rp) + tt, pl + tRl]
-            + [x + y for x, y in zip(Rcr, cross(t, Rl))]
-            + [a - 2 * b + tt * c - 2 * pl * d - 2 * tRl * d for a, b, c, d in zip(Rf4, cross(t, Rcr), Rl, t)])
+    return (
+        Rl
+        + [x + y for x, y in zip(Rp, t)]
+        + [pp + 2 * dot(t, Rp) + tt, pl + tRl]
+        + [x + y for x, y in zip(Rcr, cross(t, Rl))]
+        + [a - 2 * b + tt * c - 2 * pl * d - 2 * tRl * d for a, b, c, d in zip(Rf4, cross(t, Rcr), Rl, t)]
+    )
 
 
 def _a_pair(j, C, S, cphi, sphi, h):
@@ -125,10 +130,10 @@ def equations(k: int):
         l = [sum(post[r][c] * l0[c] for c in range(3)) for r in range(3)]
         p = [sum(post[r][c] * p0[c] for c in range(3)) + post[r][3] for r in range(3)]
         Tg = [G[x] for x in pose]
-        FR = transform([Tg[4 * r: 4 * r + 3] for r in range(3)], [Tg[4 * r + 3] for r in range(3)], _fourteen(l, p))
+        FR = transform([Tg[4 * r : 4 * r + 3] for r in range(3)], [Tg[4 * r + 3] for r in range(3)], _fourteen(l, p))
         if k > 1:
             FR = transform([row[:3] for row in pre[:3]], [row[3] for row in pre[:3]], FR)
-    angle = lambda i: (G[J[i]["c"]], G[J[i]["s"]])  # noqa: E731
+    angle = lambda i: (G[J[i]["c"]], G[J[i]["s"]])
     iC, iS = ring.gens.index(G[A["C"]]), ring.gens.index(G[A["S"]])
     P, Q = [], []
     for eL, eR in zip(FL, FR):
@@ -148,7 +153,7 @@ def spec(k: int) -> KernelSpec:
     sub = {A["h"]: h}
     steps = [(A["cphi"], sp.cos(dh[4 * k - 1])), (A["sphi"], sp.sin(dh[4 * k - 1]))]
     for i in range(1, 7):
-        a, alpha, c, _phi = dh[4 * (i - 1): 4 * i]
+        a, alpha, c, _phi = dh[4 * (i - 1) : 4 * i]
         sub[J[i]["a"]], sub[J[i]["d"]] = a, c
         steps += [(J[i]["ca"], sp.cos(alpha)), (J[i]["sa"], sp.sin(alpha))]
     if k == 3:
@@ -165,17 +170,23 @@ def spec(k: int) -> KernelSpec:
     Q_out = [sp.S(x).xreplace(sub) for row in Q for x in row]
     return KernelSpec(
         name=f"ik1a5r_equations_{k}",
-        doc=(f"The Raghavan-Roth equations P(C, S) X{m1}{m2} = Q X{r1}{r2} of a six-joint chain whose joint {k} is "
-             f"a sinusoidal A-pair (amplitude h; (C, S) its half angle; psi_i = theta_i + phi_i), joint {e} "
-             f"eliminated: P (14 x 9 x 9) on (1, C, C^2, C^3, C^4, S, SC, SC^2, SC^3) x (1, c{m1}, s{m1}) x "
-             f"(1, c{m2}, s{m2}) and Q (14 x 9) on (1, c{r1}, s{r1}) x (1, c{r2}, s{r2})."),
+        doc=(
+            f"The Raghavan-Roth equations P(C, S) X{m1}{m2} = Q X{r1}{r2} of a six-joint chain whose joint {k} is "
+            f"a sinusoidal A-pair (amplitude h; (C, S) its half angle; psi_i = theta_i + phi_i), joint {e} "
+            f"eliminated: P (14 x 9 x 9) on (1, C, C^2, C^3, C^4, S, SC, SC^2, SC^3) x (1, c{m1}, s{m1}) x "
+            f"(1, c{m2}, s{m2}) and Q (14 x 9) on (1, c{r1}, s{r1}) x (1, c{r2}, s{r2})."
+        ),
         source=SOURCE,
-        inputs=[Arg("dh", (6, 4), "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])", tuple(dh), design=True),
-                Arg("h", (1,), f"joint {k}'s amplitude [m]", (h,), design=True),
-                Arg("T", (4, 4), "the pose, row-major", tuple(Tm))],
+        inputs=[
+            Arg("dh", (6, 4), "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])", tuple(dh), design=True),
+            Arg("h", (1,), f"joint {k}'s amplitude [m]", (h,), design=True),
+            Arg("T", (4, 4), "the pose, row-major", tuple(Tm)),
+        ],
         steps=steps,
-        outputs=[Arg("P", (ROWS, 9, 9), "the left side's coefficients (design only)", exprs=tuple(P_out)),
-                 Arg("Q", (ROWS, 9), "the right side's coefficients", exprs=tuple(Q_out))],
+        outputs=[
+            Arg("P", (ROWS, 9, 9), "the left side's coefficients (design only)", exprs=tuple(P_out)),
+            Arg("Q", (ROWS, 9), "the right side's coefficients", exprs=tuple(Q_out)),
+        ],
     )
 
 
@@ -189,8 +200,15 @@ def check_equations(kernel: KernelSpec, k: int, samples: int = 3, digits: int = 
     worst = 0.0
     with mpmath.workdps(digits):
         for _ in range(samples):
-            dh = [[mpmath.mpf(rng.uniform(-1, 1)), mpmath.mpf(rng.uniform(-3, 3)), mpmath.mpf(rng.uniform(-1, 1)),
-                   mpmath.mpf(rng.uniform(-3, 3))] for _ in range(6)]
+            dh = [
+                [
+                    mpmath.mpf(rng.uniform(-1, 1)),
+                    mpmath.mpf(rng.uniform(-3, 3)),
+                    mpmath.mpf(rng.uniform(-1, 1)),
+                    mpmath.mpf(rng.uniform(-3, 3)),
+                ]
+                for _ in range(6)
+            ]
             h = mpmath.mpf(rng.uniform(0.05, 0.5))
             theta = [mpmath.mpf(rng.uniform(-6, 6)) for _ in range(6)]
             T = mpmath.eye(4)
@@ -203,10 +221,10 @@ def check_equations(kernel: KernelSpec, k: int, samples: int = 3, digits: int = 
             for s, ex in kernel.steps:
                 env[s] = sp.Float(sp.N(ex.xreplace(env), digits), digits)
             vals = [mpmath.mpf(sp.N(ex.xreplace(env), digits)) for a in kernel.outputs for ex in a.exprs]
-            Pv, Qv = vals[:ROWS * 81], vals[ROWS * 81:]
-            cs = lambda i: [1, mpmath.cos(theta[i - 1] + dh[i - 1][3]), mpmath.sin(theta[i - 1] + dh[i - 1][3])]  # noqa: E731
+            Pv, Qv = vals[: ROWS * 81], vals[ROWS * 81 :]
+            cs = lambda i: [1, mpmath.cos(theta[i - 1] + dh[i - 1][3]), mpmath.sin(theta[i - 1] + dh[i - 1][3])]
             C, S = mpmath.cos(theta[k - 1] / 2), mpmath.sin(theta[k - 1] / 2)
-            basis = [C ** i * S ** j for i, j in A_BASIS]
+            basis = [C**i * S**j for i, j in A_BASIS]
             XL = [x * y for x in cs(m1) for y in cs(m2)]
             XR = [x * y for x in cs(r1) for y in cs(r2)]
             for r in range(ROWS):

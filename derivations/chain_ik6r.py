@@ -23,6 +23,7 @@ the method rests on), and `check_equations` verifies them at random 6R poses in 
 arithmetic, through the DH product of docs/conventions.md §3 (mpmath), independently of the
 symbolic route.
 """
+
 from __future__ import annotations
 
 import random
@@ -114,13 +115,13 @@ def equations():
     lL, pL = [left[r][2] for r in range(3)], [left[r][3] for r in range(3)]
     lR = [sum(right[r][k] * G[u[k]] for k in range(3)) for r in range(3)]
     pR = [sum(right[r][k] * G[w[k]] for k in range(3)) + right[r][3] for r in range(3)]
-    angle = lambda i: (J[i]["c"], J[i]["s"])  # noqa: E731
-    gen = lambda pair: tuple(G[x] for x in pair)  # noqa: E731
+    angle = lambda i: (J[i]["c"], J[i]["s"])
+    gen = lambda pair: tuple(G[x] for x in pair)
     P, Q = [], []
     for eL, eR in zip(_fourteen(lL, pL), _fourteen(lR, pR)):
         eL, eR = ring(eL).rem(circles), ring(eR).rem(circles)
         coeffs = _coefficients(eL, [gen(angle(3)), gen(angle(4)), gen(angle(5))], ring)  # (1, c3, s3) ⊗ X45
-        P.append([coeffs[9 * k: 9 * k + 9] for k in range(3)])
+        P.append([coeffs[9 * k : 9 * k + 9] for k in range(3)])
         Q.append(_coefficients(eR, [gen(angle(1)), gen(angle(2))], ring))
     return P, Q, u, w, J
 
@@ -133,7 +134,7 @@ def spec() -> KernelSpec:
     steps = []
     sub = {}
     for i in range(1, 7):
-        a, alpha, c, _phi = dh[4 * (i - 1): 4 * i]
+        a, alpha, c, _phi = dh[4 * (i - 1) : 4 * i]
         sub[J[i]["a"]], sub[J[i]["d"]] = a, c
         steps += [(J[i]["ca"], sp.cos(alpha)), (J[i]["sa"], sp.sin(alpha))]
     # A_6⁻¹'s third and fourth columns: (0, sin α6, cos α6, 0) and (−a6, −c6 sin α6, −c6 cos α6, 1)
@@ -148,16 +149,21 @@ def spec() -> KernelSpec:
     Q_out = [sp.S(e).xreplace(sub) for row in Q for e in row]
     return KernelSpec(
         name="ik6r_equations",
-        doc=("The Raghavan-Roth equations P(psi_3) X45 = Q X12 of a 6R chain at the pose T (psi_i = theta_i + "
-             "phi_i): P (14 x 3 x 9) on (1, c3, s3) x (1, c4, s4) x (1, c5, s5) and Q (14 x 9) on "
-             "(1, c1, s1) x (1, c2, s2)."),
+        doc=(
+            "The Raghavan-Roth equations P(psi_3) X45 = Q X12 of a 6R chain at the pose T (psi_i = theta_i + "
+            "phi_i): P (14 x 3 x 9) on (1, c3, s3) x (1, c4, s4) x (1, c5, s5) and Q (14 x 9) on "
+            "(1, c1, s1) x (1, c2, s2)."
+        ),
         source=SOURCE,
-        inputs=[Arg("dh", (6, 4), "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])", tuple(dh),
-                    design=True),
-                Arg("T", (4, 4), "the pose, row-major", tuple(Tm))],
+        inputs=[
+            Arg("dh", (6, 4), "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])", tuple(dh), design=True),
+            Arg("T", (4, 4), "the pose, row-major", tuple(Tm)),
+        ],
         steps=steps,
-        outputs=[Arg("P", (ROWS, 3, 9), "the left side's coefficients (design only)", exprs=tuple(P_out)),
-                 Arg("Q", (ROWS, 9), "the right side's coefficients", exprs=tuple(Q_out))],
+        outputs=[
+            Arg("P", (ROWS, 3, 9), "the left side's coefficients (design only)", exprs=tuple(P_out)),
+            Arg("Q", (ROWS, 9), "the right side's coefficients", exprs=tuple(Q_out)),
+        ],
     )
 
 
@@ -169,8 +175,15 @@ def check_equations(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> f
     worst = 0.0
     with mpmath.workdps(digits):
         for _ in range(samples):
-            dh = [[mpmath.mpf(rng.uniform(-1, 1)), mpmath.mpf(rng.uniform(-3, 3)), mpmath.mpf(rng.uniform(-1, 1)),
-                   mpmath.mpf(rng.uniform(-3, 3))] for _ in range(6)]
+            dh = [
+                [
+                    mpmath.mpf(rng.uniform(-1, 1)),
+                    mpmath.mpf(rng.uniform(-3, 3)),
+                    mpmath.mpf(rng.uniform(-1, 1)),
+                    mpmath.mpf(rng.uniform(-3, 3)),
+                ]
+                for _ in range(6)
+            ]
             psi = [mpmath.mpf(rng.uniform(-3, 3)) for _ in range(6)]
             T = mpmath.eye(4)
             for i in range(6):
@@ -180,8 +193,8 @@ def check_equations(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> f
             for s, e in kernel.steps:
                 env[s] = sp.Float(sp.N(e.xreplace(env), digits), digits)
             vals = [mpmath.mpf(sp.N(e.xreplace(env), digits)) for a in kernel.outputs for e in a.exprs]
-            Pv, Qv = vals[:ROWS * 27], vals[ROWS * 27:]
-            cs = lambda i: [1, mpmath.cos(psi[i]), mpmath.sin(psi[i])]  # noqa: E731
+            Pv, Qv = vals[: ROWS * 27], vals[ROWS * 27 :]
+            cs = lambda i: [1, mpmath.cos(psi[i]), mpmath.sin(psi[i])]
             X45 = [x * y for x in cs(3) for y in cs(4)]
             X12 = [x * y for x in cs(0) for y in cs(1)]
             t3 = cs(2)

@@ -12,6 +12,7 @@ rotation applied one elementary factor at a time), so the expanded expression is
 frames; `check_jacobian` proves it equal to the derivative of the forward kinematics
 (chain rule through d_i(θ_i)) at random points in 50-digit arithmetic.
 """
+
 from __future__ import annotations
 
 import random
@@ -27,8 +28,9 @@ MAX_N = 6
 
 
 LAW_FIELDS = ("ch", "sh", "d", "dd", "ddd")
-LAW_DOC = ("per joint (cos(theta_i/2), sin(theta_i/2), d_i [m], d'_i [m/rad], d''_i [m/rad^2]) from the "
-           "pair's law kernel")
+LAW_DOC = (
+    "per joint (cos(theta_i/2), sin(theta_i/2), d_i [m], d'_i [m/rad], d''_i [m/rad^2]) from the pair's law kernel"
+)
 
 
 def joint_symbols(i: int) -> dict[str, sp.Symbol]:
@@ -43,8 +45,13 @@ def chain_inputs(n: int) -> tuple[list[Arg], list[dict]]:
     J = [joint_symbols(i) for i in range(1, n + 1)]
     return [
         Arg("law", (n, 5), LAW_DOC, tuple(j[k] for j in J for k in LAW_FIELDS)),
-        Arg("dh", (n, 4), "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])",
-            tuple(j[k] for j in J for k in ("a", "alpha", "c", "phi")), design=True),
+        Arg(
+            "dh",
+            (n, 4),
+            "per joint (a_i [m], alpha_i [rad], c_i [m], phi_i [rad])",
+            tuple(j[k] for j in J for k in ("a", "alpha", "c", "phi")),
+            design=True,
+        ),
     ], J
 
 
@@ -57,7 +64,7 @@ def at_angles(J: list[dict]) -> dict:
     return out
 
 
-def joint_trig(j: dict, rec: "_Recorder", label: str) -> tuple[sp.Expr, sp.Expr, sp.Expr, sp.Expr]:
+def joint_trig(j: dict, rec: _Recorder, label: str) -> tuple[sp.Expr, sp.Expr, sp.Expr, sp.Expr]:
     """(cos θ, sin θ, cos(θ + φ), sin(θ + φ)) of joint j as steps, from the half-angle law values
     (or from cos θ, sin θ themselves where j has them: the inverse-kinematics system's inputs)."""
     if "ct" in j:
@@ -100,8 +107,12 @@ def dh_study(j: dict, half=None):
     if half is None:
         half = dh_study_half(j)
     half_a = j["alpha"] / 2
-    return (rotation((0, 0, 1), *half) * translation((0, 0, j["c"] + j["d"]))
-            * translation((j["a"], 0, 0)) * rotation((1, 0, 0), sp.cos(half_a), sp.sin(half_a)))
+    return (
+        rotation((0, 0, 1), *half)
+        * translation((0, 0, j["c"] + j["d"]))
+        * translation((j["a"], 0, 0))
+        * rotation((1, 0, 0), sp.cos(half_a), sp.sin(half_a))
+    )
 
 
 class _Recorder:
@@ -149,7 +160,9 @@ def fk_spec(n: int) -> KernelSpec:
     return KernelSpec(
         name=f"fk{n}",
         doc=f"Forward kinematics of a {n}-joint chain: T = A_1 ... A_{n}, base frame -> frame {n}.",
-        source=SOURCE, inputs=inputs, steps=rec.steps,
+        source=SOURCE,
+        inputs=inputs,
+        steps=rec.steps,
         outputs=[Arg("T", (4, 4), "homogeneous transform, row-major", exprs=tuple(T))],
     )
 
@@ -157,6 +170,7 @@ def fk_spec(n: int) -> KernelSpec:
 def fk_study_spec(n: int) -> KernelSpec:
     inputs, J = chain_inputs(n)
     rec = _Recorder()
+
     def joint(i, j):
         half = [rec.name(f"H{i}_{k}", e) for k, e in enumerate(dh_study_half(j))]
         return [rec.name(f"Q{i}_{k}", sp.expand(c)) for k, c in enumerate(dh_study(j, half).as_list())]
@@ -165,13 +179,19 @@ def fk_study_spec(n: int) -> KernelSpec:
     for i, j in enumerate(J[1:], start=2):
         prev = [rec.name(f"S{i - 1}_{k}", c) for k, c in enumerate(comps)]
         joint_i = joint(i, j)
-        P = StudyPoint(Quaternion(*prev[:4]), Quaternion(*prev[4:])) * StudyPoint(Quaternion(*joint_i[:4]), Quaternion(*joint_i[4:]))
+        P = StudyPoint(Quaternion(*prev[:4]), Quaternion(*prev[4:])) * StudyPoint(
+            Quaternion(*joint_i[:4]), Quaternion(*joint_i[4:])
+        )
         comps = [sp.expand(c) for c in P.as_list()]
     return KernelSpec(
         name=f"fk_study{n}",
-        doc=(f"Study point (x0..x3, y0..y3) of a {n}-joint chain, the dual-quaternion product of the joints'; "
-             "x is a unit quaternion, and (x, y) ~ (-x, -y)."),
-        source=SOURCE, inputs=inputs, steps=rec.steps,
+        doc=(
+            f"Study point (x0..x3, y0..y3) of a {n}-joint chain, the dual-quaternion product of the joints'; "
+            "x is a unit quaternion, and (x, y) ~ (-x, -y)."
+        ),
+        source=SOURCE,
+        inputs=inputs,
+        steps=rec.steps,
         outputs=[Arg("study", (8,), "Study parameters (x0, x1, x2, x3, y0, y1, y2, y3)", exprs=tuple(comps))],
     )
 
@@ -196,9 +216,13 @@ def jacobian_spec(n: int) -> KernelSpec:
     Jm = screw_jacobian(F, J)
     return KernelSpec(
         name=f"jacobian{n}",
-        doc=(f"Geometric Jacobian (6 x {n}, base frame, rows [v; omega], v the velocity of the origin of "
-             f"frame {n}) of a {n}-joint chain; column i includes the pitch d'_i along z_(i-1)."),
-        source=SOURCE, inputs=inputs, steps=rec.steps,
+        doc=(
+            f"Geometric Jacobian (6 x {n}, base frame, rows [v; omega], v the velocity of the origin of "
+            f"frame {n}) of a {n}-joint chain; column i includes the pitch d'_i along z_(i-1)."
+        ),
+        source=SOURCE,
+        inputs=inputs,
+        steps=rec.steps,
         outputs=[Arg("J", (6, n), "Jacobian, row-major", exprs=tuple(Jm))],
     )
 
@@ -273,8 +297,10 @@ def chain_study_polynomials(n: int = 2) -> PolynomialSet:
         half_t, half_a = (j["theta"] + j["phi"]) / 2, j["alpha"] / 2
         subs.update({sp.cos(half_t): C, sp.sin(half_t): S, sp.cos(half_a): K, sp.sin(half_a): L})
         Q = dh_study(j, (sp.cos(half_t), sp.sin(half_t)))
-        Q = StudyPoint(Quaternion(*[sp.expand(c).xreplace(subs).subs(j["c"] + j["d"], D) for c in Q.x.as_list()]),
-                       Quaternion(*[sp.expand(sp.expand(c).xreplace(subs).subs(j["c"], D - j["d"])) for c in Q.y.as_list()]))
+        Q = StudyPoint(
+            Quaternion(*[sp.expand(c).xreplace(subs).subs(j["c"] + j["d"], D) for c in Q.x.as_list()]),
+            Quaternion(*[sp.expand(sp.expand(c).xreplace(subs).subs(j["c"], D - j["d"])) for c in Q.y.as_list()]),
+        )
         P = Q if P is None else P * Q
     names = ["x0", "x1", "x2", "x3", "y0", "y1", "y2", "y3"]
     comps = [sp.expand(c) for c in P.as_list()]
@@ -284,8 +310,10 @@ def chain_study_polynomials(n: int = 2) -> PolynomialSet:
         name=f"chain{n}_study",
         title=f"Study point of a {n}-joint A-chain in half-angle variables",
         source=SOURCE,
-        description=("C_i, S_i = cos, sin((theta_i + phi_i)/2); K_i, L_i = cos, sin(alpha_i/2); "
-                     "D_i = c_i + d_i(theta_i) (d_i = h_i cos(theta_i/2) for a sinusoidal pair)."),
+        description=(
+            "C_i, S_i = cos, sin((theta_i + phi_i)/2); K_i, L_i = cos, sin(alpha_i/2); "
+            "D_i = c_i + d_i(theta_i) (d_i = h_i cos(theta_i/2) for a sinusoidal pair)."
+        ),
         entries=[Entry(nm, c, tuple(gens)) for nm, c in zip(names, comps)],
     )
 

@@ -19,6 +19,7 @@ Certificate: at a random rational design the generators span every linear form a
 vanishes on that chain's image (their rank equals the nullity of the specialised system). Check: the
 2R chain's image is a quadric surface in a 3-space (four linear forms, then only the Study quadric).
 """
+
 from __future__ import annotations
 
 import itertools
@@ -213,8 +214,12 @@ def generators(chain: Chain) -> dict[int, list[tuple[tuple[int, int], dict]]]:
 
 def as_expr(form: dict, chain: Chain) -> sp.Expr:
     params = chain.gens[2:]
-    return sp.Add(*(c * sp.Mul(*(g**p for g, p in zip(VARS, m))) * sp.Mul(*(g**p for g, p in zip(params, shift)))
-                    for (m, shift), c in form.items()))
+    return sp.Add(
+        *(
+            c * sp.Mul(*(g**p for g, p in zip(VARS, m))) * sp.Mul(*(g**p for g, p in zip(params, shift)))
+            for (m, shift), c in form.items()
+        )
+    )
 
 
 def certify(chain: Chain, found: dict, rng: random.Random) -> tuple[dict[int, int], dict[int, list[bool]]]:
@@ -256,12 +261,20 @@ def derive():
         for k, name in ((1, "L"), (2, "Q")):
             for i, (((e, w), form), gen) in enumerate(zip(found[k], generic[k])):
                 expr = sp.expand(as_expr(form, chain))
-                entries.append(Entry(f"{kinds}_{name}{i}", expr, tuple(VARS),
-                                     f"{kinds}; degree {e} in (c_alpha, s_alpha), {w} in lengths and y; "
-                                     + ("generic" if gen else "special designs only")))
-        facts[kinds]["summary"] = (f"{kinds}: {len(found[1])} linear forms and {len(found[2])} quadrics "
-                                   f"({sum(generic[1])} and {sum(generic[2])} needed at a generic design), "
-                                   f"spanning {dims[1]} linear forms and {dims[2]} quadrics there")
+                entries.append(
+                    Entry(
+                        f"{kinds}_{name}{i}",
+                        expr,
+                        tuple(VARS),
+                        f"{kinds}; degree {e} in (c_alpha, s_alpha), {w} in lengths and y; "
+                        + ("generic" if gen else "special designs only"),
+                    )
+                )
+        facts[kinds]["summary"] = (
+            f"{kinds}: {len(found[1])} linear forms and {len(found[2])} quadrics "
+            f"({sum(generic[1])} and {sum(generic[2])} needed at a generic design), "
+            f"spanning {dims[1]} linear forms and {dims[2]} quadrics there"
+        )
     rr = facts["RR"]  # 2R: a quadric surface in a 3-space, the 3-space cut out by 4 linear forms
     assert rr["dims"] == {1: 4, 2: 8 * 4 - 6 + 1} and rr["generic"] == {1: 4, 2: 1}, rr
     assert facts["AA"]["dims"][1] == 0
@@ -270,8 +283,14 @@ def derive():
         "P1(u1)·Tx(a)Rx(alpha)·P2(u2) (A = sinusoidal A-pair of amplitude h_i, R = revolute), with the "
         "design symbolic: (c_alpha, s_alpha) = (cos(alpha/2), sin(alpha/2)) up to a factor, a the link "
         "length. Valid for every design; at a generic design they span all such forms. "
-        + "; ".join(facts[k]["summary"] for k in CHAINS) + ".")
-    ps = PolynomialSet(name="chain_variety_symbolic",
-                       title="Constraint varieties of 2-joint chains with symbolic design: linear forms and quadrics",
-                       source=SOURCE, description=description, entries=entries)
+        + "; ".join(facts[k]["summary"] for k in CHAINS)
+        + "."
+    )
+    ps = PolynomialSet(
+        name="chain_variety_symbolic",
+        title="Constraint varieties of 2-joint chains with symbolic design: linear forms and quadrics",
+        source=SOURCE,
+        description=description,
+        entries=entries,
+    )
     return [ps], [], facts

@@ -4,6 +4,7 @@ Only the algebra the derivations need: the Hamilton product, conjugation, and th
 form of the elementary motions (rotation about an axis through the origin, translation), so that
 every Study point in the derivations is *computed* from a displacement, never typed in.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -21,11 +22,11 @@ class Quaternion:
     z: sp.Expr
 
     @staticmethod
-    def pure(v) -> "Quaternion":
+    def pure(v) -> Quaternion:
         """The pure quaternion (0, v) of a 3-vector."""
         return Quaternion(sp.S(0), sp.S(v[0]), sp.S(v[1]), sp.S(v[2]))
 
-    def __mul__(self, o: "Quaternion") -> "Quaternion":
+    def __mul__(self, o: Quaternion) -> Quaternion:
         a, b = self, o
         return Quaternion(
             a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
@@ -34,22 +35,22 @@ class Quaternion:
             a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w,
         )
 
-    def __add__(self, o: "Quaternion") -> "Quaternion":
+    def __add__(self, o: Quaternion) -> Quaternion:
         return Quaternion(self.w + o.w, self.x + o.x, self.y + o.y, self.z + o.z)
 
-    def __sub__(self, o: "Quaternion") -> "Quaternion":
+    def __sub__(self, o: Quaternion) -> Quaternion:
         return Quaternion(self.w - o.w, self.x - o.x, self.y - o.y, self.z - o.z)
 
-    def scale(self, s) -> "Quaternion":
+    def scale(self, s) -> Quaternion:
         return Quaternion(s * self.w, s * self.x, s * self.y, s * self.z)
 
-    def conj(self) -> "Quaternion":
+    def conj(self) -> Quaternion:
         return Quaternion(self.w, -self.x, -self.y, -self.z)
 
     def norm2(self) -> sp.Expr:
         return self.w**2 + self.x**2 + self.y**2 + self.z**2
 
-    def dot(self, o: "Quaternion") -> sp.Expr:
+    def dot(self, o: Quaternion) -> sp.Expr:
         return self.w * o.w + self.x * o.x + self.y * o.y + self.z * o.z
 
     def vec(self) -> list[sp.Expr]:
@@ -58,7 +59,7 @@ class Quaternion:
     def as_list(self) -> list[sp.Expr]:
         return [self.w, self.x, self.y, self.z]
 
-    def expand(self) -> "Quaternion":
+    def expand(self) -> Quaternion:
         return Quaternion(*(sp.expand(c) for c in self.as_list()))
 
 
@@ -69,7 +70,7 @@ class StudyPoint:
     x: Quaternion
     y: Quaternion
 
-    def __mul__(self, o: "StudyPoint") -> "StudyPoint":
+    def __mul__(self, o: StudyPoint) -> StudyPoint:
         # (x1 + ε y1)(x2 + ε y2) = x1 x2 + ε (x1 y2 + y1 x2): composition T1·T2.
         return StudyPoint(self.x * o.x, self.x * o.y + self.y * o.x)
 

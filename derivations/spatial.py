@@ -9,6 +9,7 @@ rotation about a coordinate axis touches two components, a translation along one
 which is what makes the body-frame recursions of derivations/chain_dynamics.py cheap. Every result
 is named by the recorder, so a recursion stays linear in size.
 """
+
 from __future__ import annotations
 
 import sympy as sp
@@ -53,8 +54,15 @@ class Namer:
 
     def mat3(self, tag: str, M) -> sp.Matrix:
         self.count += 1
-        return sp.Matrix(3, 3, [self.rec.name(f"{self.prefix}{tag}{self.count}_{r}{c}", sp.expand(M[r, c]))
-                                for r in range(3) for c in range(3)])
+        return sp.Matrix(
+            3,
+            3,
+            [
+                self.rec.name(f"{self.prefix}{tag}{self.count}_{r}{c}", sp.expand(M[r, c]))
+                for r in range(3)
+                for c in range(3)
+            ],
+        )
 
 
 def motion_to_child(chain, V, nm: Namer, tag: str = "v"):
@@ -94,8 +102,10 @@ def inertia_to_parent(chain, inertia, nm: Namer, tag: str = "I"):
         else:
             p = offset(e)
             if Ib is not None:
-                Ib = nm.sym3(tag, Ib + m * ((p.T * p)[0] * sp.eye(3) - p * p.T)
-                             + 2 * (p.T * h)[0] * sp.eye(3) - p * h.T - h * p.T)
+                Ib = nm.sym3(
+                    tag,
+                    Ib + m * ((p.T * p)[0] * sp.eye(3) - p * p.T) + 2 * (p.T * h)[0] * sp.eye(3) - p * h.T - h * p.T,
+                )
             h = nm.vec(tag + "h", h + m * p)
     return m, h, Ib
 

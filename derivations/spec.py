@@ -5,6 +5,7 @@ expressions. Large results are built as an ordered list of `steps` (intermediate
 the way a recursion is written by hand, so the expanded expression tree is never formed; `outputs`
 may refer to step symbols. `PolynomialSet` carries the human-readable results of a derivation.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -41,7 +42,7 @@ class Call:
     (same shape), "r<k>" for the output of the caller's k-th call (an earlier one, same size), or
     None for zeros, and `results` are the caller's symbols for the callee's output, row-major."""
 
-    kernel: "KernelSpec"
+    kernel: KernelSpec
     args: tuple[str | None, ...]
     results: tuple[sp.Symbol, ...]
 
@@ -79,8 +80,10 @@ class KernelSpec:
         for k, c in enumerate(self.calls):
             callee = c.kernel
             if len(callee.outputs) != 1 or len(c.results) != callee.outputs[0].size or c.kernel.calls:
-                raise ValueError(f"{self.name}: a call of {callee.name} needs one result symbol per output entry "
-                                 "of a callee with one output and no calls of its own")
+                raise ValueError(
+                    f"{self.name}: a call of {callee.name} needs one result symbol per output entry "
+                    "of a callee with one output and no calls of its own"
+                )
             if len(c.args) != len(callee.inputs):
                 raise ValueError(f"{self.name}: {callee.name} takes {len(callee.inputs)} inputs")
             for name, a in zip(c.args, callee.inputs):
@@ -104,7 +107,7 @@ class KernelSpec:
                 if missing:
                     raise ValueError(f"{self.name}: output {a.name} uses undefined {sorted(map(str, missing))}")
 
-    def flattened(self) -> "KernelSpec":
+    def flattened(self) -> KernelSpec:
         """The same function without calls: each callee's steps inlined (renamed), its inputs
         replaced by the caller's symbols (or zeros) and its outputs bound to the result symbols."""
         if not self.calls:
@@ -115,8 +118,13 @@ class KernelSpec:
             sub = {}
             for name, a in zip(c.args, c.kernel.inputs):
                 earlier = _result_index(name)
-                given = (self.calls[earlier].results if earlier is not None else
-                         mine[name].symbols if name is not None else [0] * a.size)
+                given = (
+                    self.calls[earlier].results
+                    if earlier is not None
+                    else mine[name].symbols
+                    if name is not None
+                    else [0] * a.size
+                )
                 for s, t in zip(a.symbols, given):
                     sub[s] = sp.S(t)
             for sym, e in c.kernel.steps:

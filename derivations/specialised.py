@@ -15,6 +15,7 @@ exactly 0 as the chain file meant it (the generic kernels see cos(1.570796326794
 every other constant is the exact value of its double, carried at 40 digits through the folding
 and printed as the nearest double.
 """
+
 from __future__ import annotations
 
 import math
@@ -29,9 +30,16 @@ SOURCE = "derivations/specialised.py"
 DIGITS = 40  # precision of the constants folded at generation time
 # Public kernel name -> the generic kernel family it specialises, in the order of the output files.
 KERNELS = {
-    "fk": "fk", "fk_study": "fk_study", "jacobian": "jacobian", "mass_matrix": "mass_matrix",
-    "coriolis": "coriolis", "gravity_torques": "gravity", "bias": "bias", "inverse_dynamics": "inverse_dynamics",
-    "forward_dynamics": "forward_dynamics", "energy": "energy",
+    "fk": "fk",
+    "fk_study": "fk_study",
+    "jacobian": "jacobian",
+    "mass_matrix": "mass_matrix",
+    "coriolis": "coriolis",
+    "gravity_torques": "gravity",
+    "bias": "bias",
+    "inverse_dynamics": "inverse_dynamics",
+    "forward_dynamics": "forward_dynamics",
+    "energy": "energy",
 }
 KINEMATIC = ("fk", "fk_study", "jacobian")
 KINDS = ("revolute", "sinusoidal", "general")
@@ -72,11 +80,14 @@ class Design:
 
     def canonical(self) -> str:
         """The design as text, every number exact (float.hex): what the content hash covers."""
+
         def row(r):
             return "(" + ", ".join(float(x).hex() for x in r) + ")"
 
-        lines = [f"joint {i + 1}: {k} law {row(p)} dh {row(d)} link {row(l)} legs {row(g)}"
-                 for i, (k, p, d, l, g) in enumerate(zip(self.kinds, self.law, self.dh, self.links, self.legs))]
+        lines = [
+            f"joint {i + 1}: {k} law {row(p)} dh {row(d)} link {row(l)} legs {row(g)}"
+            for i, (k, p, d, l, g) in enumerate(zip(self.kinds, self.law, self.dh, self.links, self.legs))
+        ]
         return "\n".join(lines + [f"gravity {row(self.gravity)}"]) + "\n"
 
 
@@ -141,7 +152,7 @@ def law_steps(design: Design, law_symbols, q: Arg) -> tuple[list, dict]:
         sub.update({a.symbols[0]: _number(x) for a, x in zip(spec.inputs[1:], params)})
         more, sub = _fold(spec.steps, sub, suffix=f"_{i + 1}")
         steps += more
-        for s, e in zip(law_symbols[5 * i:5 * i + 5], spec.outputs[0].exprs):
+        for s, e in zip(law_symbols[5 * i : 5 * i + 5], spec.outputs[0].exprs):
             env[s] = _floats(sp.S(e).xreplace(sub))
     return steps, env
 
@@ -191,22 +202,36 @@ def specialise(spec: KernelSpec, design: Design, name: str, doc: str, zeros=(), 
     inputs = head + [a for a in flat.inputs if a.name in STATE and a.name not in zeros]
     calls = []
     if keep:
-        laws = KernelSpec(f"{name}_law", f"Part of {name}: the joints' law values at q.", SOURCE, [q],
-                          [Arg("law", law.shape, law.doc, exprs=tuple(env[s] for s in law.symbols))], steps)
+        laws = KernelSpec(
+            f"{name}_law",
+            f"Part of {name}: the joints' law values at q.",
+            SOURCE,
+            [q],
+            [Arg("law", law.shape, law.doc, exprs=tuple(env[s] for s in law.symbols))],
+            steps,
+        )
         steps = []
         calls.append(Call(laws, ("q",), tuple(sp.Symbol(f"{s.name}_v", real=True) for s in law.symbols)))
         for c in flat.calls:
             passed = {a.name: arg for arg, a in zip(c.args, c.kernel.inputs)}
             part_zeros = [a for a, arg in passed.items() if arg is None]
             family = c.kernel.name.rstrip("0123456789")
-            part = specialise(c.kernel, design, f"{name}_{family}", f"Part of {name}: " + c.kernel.doc.replace(
-                f" of a {design.n}-joint chain", "") + "".join(f" With {z} = 0." for z in part_zeros),
-                zeros=part_zeros, law_input=True)
+            part = specialise(
+                c.kernel,
+                design,
+                f"{name}_{family}",
+                f"Part of {name}: "
+                + c.kernel.doc.replace(f" of a {design.n}-joint chain", "")
+                + "".join(f" With {z} = 0." for z in part_zeros),
+                zeros=part_zeros,
+                law_input=True,
+            )
             args = tuple("r0" if a.name == "law" else passed[a.name] for a in part.inputs)
             calls.append(Call(part, args, c.results))
     more, env = _fold(flat.steps, env)
-    outputs = [Arg(a.name, a.shape, a.doc, exprs=tuple(_floats(sp.S(e).xreplace(env)) for e in a.exprs))
-               for a in flat.outputs]
+    outputs = [
+        Arg(a.name, a.shape, a.doc, exprs=tuple(_floats(sp.S(e).xreplace(env)) for e in a.exprs)) for a in flat.outputs
+    ]
     return KernelSpec(name, doc, SOURCE, inputs, outputs, steps + more, calls)
 
 
@@ -214,11 +239,16 @@ def generic_specs(n: int, families) -> dict[str, KernelSpec]:
     """The generic kernels of an n-joint chain for the requested families, by family."""
     out = {}
     if any(f in KINEMATIC for f in families):
-        out.update({"fk": chain_kinematics.fk_spec(n), "fk_study": chain_kinematics.fk_study_spec(n),
-                    "jacobian": chain_kinematics.jacobian_spec(n)})
+        out.update(
+            {
+                "fk": chain_kinematics.fk_spec(n),
+                "fk_study": chain_kinematics.fk_study_spec(n),
+                "jacobian": chain_kinematics.jacobian_spec(n),
+            }
+        )
     if any(f not in out for f in families):
         for s in chain_dynamics.specs_for(n):
-            out[s.name[:-len(str(n))]] = s
+            out[s.name[: -len(str(n))]] = s
     return out
 
 
@@ -232,7 +262,8 @@ def chain_specs(design: Design, kernels=tuple(KERNELS)) -> list[KernelSpec]:
     out = []
     for k in todo:
         g = generic[KERNELS[k]]
-        doc = g.doc.replace(f"of a {design.n}-joint chain", "of this chain").replace(f"a {design.n}-joint chain",
-                                                                                    "this chain")
+        doc = g.doc.replace(f"of a {design.n}-joint chain", "of this chain").replace(
+            f"a {design.n}-joint chain", "this chain"
+        )
         out.append(specialise(g, design, k, doc))
     return out

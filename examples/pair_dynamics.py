@@ -8,6 +8,7 @@ saves a plot.
 
     python examples/pair_dynamics.py [OUT.png] [--force]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -44,16 +45,20 @@ def main(argv=None) -> int:
     theta = np.linspace(-0.95 * np.pi, 0.95 * np.pi, 381)
     Jp, Gp, Jl, Gl = contributions(pair, platform, theta)
     i = np.argmax(np.abs(Gp))
-    print(f"A-pair r_b = r_p = {r} m, h = {pair.amplitude:.4f} m, legs {pair.leg_lengths[0]:.3f} m, "
-          f"6 x {pair.leg_mass} kg; platform {platform.mass} kg")
+    print(
+        f"A-pair r_b = r_p = {r} m, h = {pair.amplitude:.4f} m, legs {pair.leg_lengths[0]:.3f} m, "
+        f"6 x {pair.leg_mass} kg; platform {platform.mass} kg"
+    )
     print(f"gravity term: legs/platform = {Gl[i] / Gp[i]:.3f} (3 m_leg / m, at every angle)")
     print(f"inertia J:    legs/platform = {np.min(Jl / Jp):.3f} .. {np.max(Jl / Jp):.3f} over the range")
     # kinetic energy at a typical speed, against the potential energy swing
     speed = 2.0  # rad/s
     T_legs = 0.5 * Jl * speed**2
     dV_plat = np.ptp(platform.mass * 9.81 * pair.translation(theta))
-    print(f"at {speed} rad/s the legs carry at most {T_legs.max() * 1e3:.2f} mJ of kinetic energy; "
-          f"the platform's potential energy swings by {dV_plat * 1e3:.1f} mJ")
+    print(
+        f"at {speed} rad/s the legs carry at most {T_legs.max() * 1e3:.2f} mJ of kinetic energy; "
+        f"the platform's potential energy swings by {dV_plat * 1e3:.1f} mJ"
+    )
 
     import matplotlib
 

@@ -1,4 +1,5 @@
 """Shared fixtures: the symbolic kernel specs (re-derived once per session) and their evaluation."""
+
 from __future__ import annotations
 
 import importlib
@@ -76,7 +77,10 @@ def _vectorised(fn):
     return np.frompyfunc(fn, 1, 1)
 
 
-_MODULE = {name: _vectorised(getattr(mpmath, name)) for name in ("cos", "sin", "tan", "sqrt", "acos", "asin", "atan", "exp", "log")}
+_MODULE = {
+    name: _vectorised(getattr(mpmath, name))
+    for name in ("cos", "sin", "tan", "sqrt", "acos", "asin", "atan", "exp", "log")
+}
 _CACHE: dict = {}
 
 
@@ -95,8 +99,16 @@ def _eval(expr, env, count):
 def arm_toml(folder):
     """A 6R arm's chain file (generic geometry, twists in degrees) written into folder: its path."""
     path = folder / "arm.toml"
-    joints = "\n".join(f"[[joint]]\npair = \"revolute\"\na = {a}\nalpha_deg = {al}\noffset = {c}\n"
-                       for a, al, c in [(0.1, 90, 0.3), (0.4, 10, 0.0), (0.05, 80, 0.02), (0.0, -70, 0.4),
-                                        (0.02, 60, 0.0), (0.0, 20, 0.1)])
-    path.write_text(f"name = \"arm\"\n{joints}")
+    joints = "\n".join(
+        f'[[joint]]\npair = "revolute"\na = {a}\nalpha_deg = {al}\noffset = {c}\n'
+        for a, al, c in [
+            (0.1, 90, 0.3),
+            (0.4, 10, 0.0),
+            (0.05, 80, 0.02),
+            (0.0, -70, 0.4),
+            (0.02, 60, 0.0),
+            (0.0, 20, 0.1),
+        ]
+    )
+    path.write_text(f'name = "arm"\n{joints}')
     return path

@@ -2,6 +2,7 @@
 counted: grimp, import-linter's graph builder, reads them all), and no hand-written module is
 over MAX_LINES lines. The layers (what may use what) are import-linter's contracts in .importlinter,
 checked by `make lint`."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -111,15 +112,19 @@ def test_import_graph_has_no_cycle():
             details = graph.get_import_details(importer=a, imported=b)
             where = f" (line {details[0]['line_number']}: {details[0]['line_contents']})" if details else ""
             lines.append(f"  {a} -> {b}{where}")
-        cycles.append(f"{len(component)} modules in a cycle ({', '.join(sorted(component))}), e.g.\n"
-                      + "\n".join(lines))
+        cycles.append(
+            f"{len(component)} modules in a cycle ({', '.join(sorted(component))}), e.g.\n" + "\n".join(lines)
+        )
     assert not cycles, "import cycles in apair:\n" + "\n".join(cycles)
 
 
 def test_no_hand_written_module_is_too_long():
     """Every Python module under src/apair has at most MAX_LINES lines."""
-    sizes = {p.relative_to(ROOT).as_posix(): len(p.read_text(encoding="utf-8").splitlines())
-             for p in SOURCE.rglob("*.py") if "__pycache__" not in p.parts}
+    sizes = {
+        p.relative_to(ROOT).as_posix(): len(p.read_text(encoding="utf-8").splitlines())
+        for p in SOURCE.rglob("*.py")
+        if "__pycache__" not in p.parts
+    }
     assert sizes
     long = {p: n for p, n in sorted(sizes.items()) if n > MAX_LINES}
     assert not long, f"modules over {MAX_LINES} lines: {long}"

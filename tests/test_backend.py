@@ -1,4 +1,5 @@
 """Backend selection: C by default, NumPy on request, and a single notice when C is missing."""
+
 from __future__ import annotations
 
 import warnings
@@ -29,8 +30,7 @@ def test_environment_selects_numpy(monkeypatch):
 
 def test_missing_library_falls_back_once(monkeypatch):
     monkeypatch.delenv("APAIR_BACKEND", raising=False)
-    chain = apair.AChain(
-        [apair.APair(0.05, 0.04), apair.APair.revolute()], [0.3, 0.2], [np.pi / 2, 0.0])
+    chain = apair.AChain([apair.APair(0.05, 0.04), apair.APair.revolute()], [0.3, 0.2], [np.pi / 2, 0.0])
     q = np.array([0.2, -0.4])
     with_c = chain.fk(q)
     monkeypatch.setattr(kernels, "_native", lambda: (None, "the compiled C kernels are gone (test)"))

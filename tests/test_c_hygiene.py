@@ -6,6 +6,7 @@ The driver is written from generated/manifest.json: it calls every kernel, singl
 shared, stride-0 input) and through the registry, and checks them against each other. The example
 program (examples/c/chain_4a.c) is checked number by number against the Python runtime.
 """
+
 from __future__ import annotations
 
 import json
@@ -45,9 +46,19 @@ def size(shape) -> int:
 def driver_source() -> str:
     """A C program that exercises every kernel and exits non-zero on a mismatch or a non-finite value."""
     prefix = MANIFEST["prefix"]
-    lines = ['#include <math.h>', '#include <stdio.h>', '#include <stdlib.h>', '#include "apair.h"', "",
-             "static double val(int i) { return 0.1 + 0.5 * (double)((i * 7919) % 101) / 101.0; }", "",
-             "int main(void)", "{", "    int failures = 0;", "    int i, k;"]
+    lines = [
+        "#include <math.h>",
+        "#include <stdio.h>",
+        "#include <stdlib.h>",
+        '#include "apair.h"',
+        "",
+        "static double val(int i) { return 0.1 + 0.5 * (double)((i * 7919) % 101) / 101.0; }",
+        "",
+        "int main(void)",
+        "{",
+        "    int failures = 0;",
+        "    int i, k;",
+    ]
     count = 5
     for name, k in sorted(MANIFEST["kernels"].items()):
         lines.append("    {")
@@ -63,7 +74,9 @@ def driver_source() -> str:
             n = size(a["shape"])
             lines.append(f"        double out{j}[{n * count}], one{j}[{n}], batch{j}[{n * count}];")
             lines.append(f"        for (i = 0; i < {n * count}; ++i) out{j}[i] = NAN;")
-        ins = lambda off: ", ".join(f"in{j} + {off if j == 0 else 0} * {size(a['shape'])}" for j, a in enumerate(k["inputs"]))
+        ins = lambda off: ", ".join(
+            f"in{j} + {off if j == 0 else 0} * {size(a['shape'])}" for j, a in enumerate(k["inputs"])
+        )
         strided = ", ".join(f"in{j}, {size(a['shape']) if j == 0 else 0}" for j, a in enumerate(k["inputs"]))
         outs_b = ", ".join(f"out{j}" for j in range(len(k["outputs"])))
         outs_1 = ", ".join(f"one{j}" for j in range(len(k["outputs"])))
@@ -92,12 +105,16 @@ def driver_source() -> str:
         lines.append(f'                printf("{name}: registry entry\\n"); ++failures;')
         lines.append("            } else {")
         for j, a in enumerate(k["outputs"]):
-            lines.append(f"                if (r->outputs[{j}].size != {size(a['shape'])}) {{ printf(\"{name}: size\\n\"); ++failures; }}")
+            lines.append(
+                f'                if (r->outputs[{j}].size != {size(a["shape"])}) {{ printf("{name}: size\\n"); ++failures; }}'
+            )
             lines.append(f"                rout[{j}] = one{j};")
         lines.append("                r->eval(rin, rout);")
         for j, a in enumerate(k["outputs"]):
             n = size(a["shape"])
-            lines.append(f"                for (i = 0; i < {n}; ++i) if (one{j}[i] != out{j}[i]) {{ printf(\"{name}: eval\\n\"); ++failures; break; }}")
+            lines.append(
+                f'                for (i = 0; i < {n}; ++i) if (one{j}[i] != out{j}[i]) {{ printf("{name}: eval\\n"); ++failures; break; }}'
+            )
         # the split form (invariants once, then the core) gives the same numbers to the bit
         lines.append("                if (r->n_invariants > 0) {")
         lines.append("                    double *inv = (double *)malloc(sizeof(double) * (size_t)r->n_invariants);")
@@ -108,23 +125,31 @@ def driver_source() -> str:
         lines.append("                    r->core(inv, rin, rout);")
         for j, a in enumerate(k["outputs"]):
             n = size(a["shape"])
-            lines.append(f"                    for (i = 0; i < {n}; ++i) if (one{j}[i] != out{j}[i]) {{ printf(\"{name}: core\\n\"); ++failures; break; }}")
+            lines.append(
+                f'                    for (i = 0; i < {n}; ++i) if (one{j}[i] != out{j}[i]) {{ printf("{name}: core\\n"); ++failures; break; }}'
+            )
         lines.append("                    free(inv);")
         lines.append("                } else if (r->invariants != NULL || r->core != NULL) {")
         lines.append(f'                    printf("{name}: split form without invariants\\n"); ++failures;')
         lines.append("                }")
-        for j, a in enumerate(k["outputs"]):
+        for j in range(len(k["outputs"])):
             lines.append(f"                rout[{j}] = batch{j};")
         lines.append(f"                r->eval_batch({count}, rin, rstride, rout);")
         for j, a in enumerate(k["outputs"]):
             n = size(a["shape"]) * count
-            lines.append(f"                for (i = 0; i < {n}; ++i) if (batch{j}[i] != out{j}[i]) {{ printf(\"{name}: eval_batch\\n\"); ++failures; break; }}")
+            lines.append(
+                f'                for (i = 0; i < {n}; ++i) if (batch{j}[i] != out{j}[i]) {{ printf("{name}: eval_batch\\n"); ++failures; break; }}'
+            )
         lines.append("            }")
         lines.append("        }")
         lines.append("    }")
-    lines += ['    if ({prefix}find_kernel("no_such_kernel") != NULL) {{ printf("registry: unknown name found\\n"); ++failures; }}'
-              .format(prefix=prefix),
-              '    if (failures == 0) printf("ok\\n");', "    return failures != 0;", "}", ""]
+    lines += [
+        f'    if ({prefix}find_kernel("no_such_kernel") != NULL) {{ printf("registry: unknown name found\\n"); ++failures; }}',
+        '    if (failures == 0) printf("ok\\n");',
+        "    return failures != 0;",
+        "}",
+        "",
+    ]
     return "\n".join(lines)
 
 
@@ -173,8 +198,9 @@ def build(compiler, lang, opt, sanitize, programs, out: Path) -> dict[str, Path]
     sources = [Path(s) for s in SOURCES] + [Path(p) for p in programs]
     objects = {src: out / f"{src.stem}.o" for src in sources}
     with ThreadPoolExecutor(max_workers=2) as pool:
-        list(pool.map(lambda src: run([compiler, *lang_flag, *flags, "-c", str(src), "-o", str(objects[src])]),
-                      sources))
+        list(
+            pool.map(lambda src: run([compiler, *lang_flag, *flags, "-c", str(src), "-o", str(objects[src])]), sources)
+        )
     lib = [str(objects[Path(s)]) for s in SOURCES]
     exes = {}
     for p in map(Path, programs):
@@ -195,7 +221,6 @@ def sanitizers_link(compiler: str, tmp: Path) -> bool:
 
 def python_state(rng):
     """The example chain and a random state: (chain, q, qd, qdd)."""
-    import numpy as np
 
     import apair
 
@@ -271,7 +296,8 @@ def test_cmake_install_serves_find_package_and_pkg_config(cmake, tmp_path):
     (consumer / "CMakeLists.txt").write_text(
         "cmake_minimum_required(VERSION 3.13)\nproject(consumer LANGUAGES C)\n"
         f"find_package(apair {MANIFEST_VERSION} CONFIG REQUIRED)\n"
-        f"add_executable(chain_4a {EXAMPLE.as_posix()})\ntarget_link_libraries(chain_4a PRIVATE apair::apair)\n")
+        f"add_executable(chain_4a {EXAMPLE.as_posix()})\ntarget_link_libraries(chain_4a PRIVATE apair::apair)\n"
+    )
     run([cmake, "-S", str(consumer), "-B", str(consumer / "build"), f"-DCMAKE_PREFIX_PATH={prefix}"])
     run([cmake, "--build", str(consumer / "build")])
     check_example(consumer / "build" / "chain_4a")
@@ -321,8 +347,10 @@ def test_no_allocation_io_or_mutable_state_in_the_library():
         for line in text.splitlines():
             if re.match(r"^static\s+(inline\s+)?(const\s+)?[A-Za-z_][\w\s\*]*\b\w+\(", line):
                 continue  # a function of file scope, not state
-            if line.startswith(("static ", "extern ")) or re.match(r"^(double|int|float|char|size_t)\b.*[=;]\s*$", line):
-                assert line.startswith(("static void", "static const", "extern const", "extern \"C\"")), (path, line)
+            if line.startswith(("static ", "extern ")) or re.match(
+                r"^(double|int|float|char|size_t)\b.*[=;]\s*$", line
+            ):
+                assert line.startswith(("static void", "static const", "extern const", 'extern "C"')), (path, line)
 
 
 def test_a_program_links_only_the_kernels_it_calls(tmp_path):
@@ -332,18 +360,36 @@ def test_a_program_links_only_the_kernels_it_calls(tmp_path):
     objects = tmp_path / "obj"
     objects.mkdir()
     with ThreadPoolExecutor(max_workers=2) as pool:
-        list(pool.map(lambda s: run(["gcc", "-std=c99", *STRICT, "-O1", f"-I{CDIR}", "-c", s, "-o",
-                                     str(objects / (Path(s).stem + ".o"))]), SOURCES))
+        list(
+            pool.map(
+                lambda s: run(
+                    [
+                        "gcc",
+                        "-std=c99",
+                        *STRICT,
+                        "-O1",
+                        f"-I{CDIR}",
+                        "-c",
+                        s,
+                        "-o",
+                        str(objects / (Path(s).stem + ".o")),
+                    ]
+                ),
+                SOURCES,
+            )
+        )
     archive = tmp_path / "libapair.a"
     run(["ar", "rcs", str(archive), *sorted(str(p) for p in objects.glob("*.o"))])
     internal = lambda k: [f"apair_internal_{k}_core", f"apair_internal_{k}_invariants"]
     public = lambda k: [f"apair_{k}", f"apair_{k}_batch", f"apair_{k}_core", f"apair_{k}_invariants"]
     cases = {
-        "apair_inverse_dynamics4(law, qd, qdd, dh, links, legs, g, out);":
-            public("inverse_dynamics4") + internal("inverse_dynamics4"),
-        "apair_forward_dynamics4(law, qd, qdd, dh, links, legs, g, out);":
-            public("forward_dynamics4") + internal("inverse_dynamics4") + internal("mass_matrix4")
-            + public("inverse_dynamics4") + public("mass_matrix4"),
+        "apair_inverse_dynamics4(law, qd, qdd, dh, links, legs, g, out);": public("inverse_dynamics4")
+        + internal("inverse_dynamics4"),
+        "apair_forward_dynamics4(law, qd, qdd, dh, links, legs, g, out);": public("forward_dynamics4")
+        + internal("inverse_dynamics4")
+        + internal("mass_matrix4")
+        + public("inverse_dynamics4")
+        + public("mass_matrix4"),
     }
     for call, expected in cases.items():
         program = tmp_path / "prog.c"
@@ -352,7 +398,8 @@ def test_a_program_links_only_the_kernels_it_calls(tmp_path):
             "1, 0, 0, 0, 0}, qd[4] = {0}, qdd[4] = {0}, dh[16] = {0}, links[40] = {0}, legs[12] = {0}, "
             "g[3] = {0, 0, -9.81}, out[4];\n    int i;\n    for (i = 0; i < 4; ++i) {\n"
             "        links[10 * i] = links[10 * i + 4] = links[10 * i + 5] = links[10 * i + 6] = 1.0;\n    }\n"
-            f"    {call}\n    return out[0] != out[0];\n}}\n")
+            f"    {call}\n    return out[0] != out[0];\n}}\n"
+        )
         exe = tmp_path / "prog"
         run(["gcc", "-std=c99", f"-I{CDIR}", str(program), str(archive), "-lm", "-o", str(exe)])
         assert subprocess.run([str(exe)]).returncode == 0
@@ -420,40 +467,70 @@ def test_ik4_kernels_under_sanitizers(tmp_path):
     left = native.ik4_left(W, elim.Zmap, j2.P, joint, elimination4.LEFT_TOL)
     assert len(W) >= 1 and np.all(left[0] != 1)
     d3, d4 = C.shape[0] - 1, C.shape[1] - 1
-    src = "\n".join([
-        '#include <stdio.h>', '#include "apair.h"',
-        c_array("C", C), c_array("Qf", Qf), c_array("Qg", Qg), c_array("af", af, "int"), c_array("ag", ag, "int"),
-        c_array("u3", u3), c_array("Q", elim.Q), c_array("probe", pencil.PROBE[:N]),
-        c_array("stol", elimination4._SCREEN_TOL),
-        c_array("W", W), c_array("Zmap", elim.Zmap), c_array("P2", j2.P), c_array("joint", joint),
-        c_array("ltol", elimination4.LEFT_TOL),
-        "static double f[289], g[289], M[512 * 512], u4[64], Wo[512], rel[64], u1[64], u2[128];",
-        "static double two[256], W2[1024], rel2[128];",
-        "static int status[64], lstatus[64], ok[128], two_ok[128];",
-        "/* these kernels use no other: the registry stays out of this build */",
-        "const apair_kernel *apair_find_kernel(const char *name) { (void)name; return NULL; }",
-        "int main(void) {",
-        "    int size = 0, i;",
-        f"    if (apair_ik4_pencil({d3}, {d4}, C, Qf, af, Qg, ag, {pencil.LEAD_COND!r}, 3, {pencil.DEFLATE_TOL!r}, f, g, M, &size)) return 1;",
-        '    printf("size %d\\nM", size);',
-        '    for (i = 0; i < size * size; i++) printf(" %.17g", M[i]);',
-        f"    if (apair_ik4_screen({len(u3)}, u3, {d3}, {d4}, C, f, {f.shape[0] - 1}, {f.shape[1] - 1}, g, "
-        f"{g.shape[0] - 1}, {g.shape[1] - 1}, {len(elim.Q)}, Q, probe, stol, status, u4, Wo, rel, two, two_ok, W2, rel2))"
-        " return 2;",
-        f'    printf("\\ntwo"); for (i = 0; i < {4 * len(u3)}; i++) printf(" %.17g", two[i]);',
-        f'    printf("\\nrel2"); for (i = 0; i < {2 * len(u3)}; i++) printf(" %.17g", rel2[i]);',
-        f'    printf("\\nu4"); for (i = 0; i < {len(u3)}; i++) printf(" %.17g", u4[i]);',
-        f'    printf("\\nstatus"); for (i = 0; i < {len(u3)}; i++) printf(" %d", status[i]);',
-        f"    if (apair_ik4_left({len(W)}, W, {elim.Zmap.shape[0] - 1}, Zmap, {j2.P.shape[0] - 1}, P2, joint, ltol, "
-        "lstatus, u1, u2, ok)) return 3;",
-        f'    printf("\\nu1"); for (i = 0; i < {len(W)}; i++) printf(" %.17g", u1[i]);',
-        f'    printf("\\nu2"); for (i = 0; i < {2 * len(W)}; i++) printf(" %.17g", u2[i]);',
-        '    printf("\\n");', "    return 0;", "}", ""])
+    src = "\n".join(
+        [
+            "#include <stdio.h>",
+            '#include "apair.h"',
+            c_array("C", C),
+            c_array("Qf", Qf),
+            c_array("Qg", Qg),
+            c_array("af", af, "int"),
+            c_array("ag", ag, "int"),
+            c_array("u3", u3),
+            c_array("Q", elim.Q),
+            c_array("probe", pencil.PROBE[:N]),
+            c_array("stol", elimination4._SCREEN_TOL),
+            c_array("W", W),
+            c_array("Zmap", elim.Zmap),
+            c_array("P2", j2.P),
+            c_array("joint", joint),
+            c_array("ltol", elimination4.LEFT_TOL),
+            "static double f[289], g[289], M[512 * 512], u4[64], Wo[512], rel[64], u1[64], u2[128];",
+            "static double two[256], W2[1024], rel2[128];",
+            "static int status[64], lstatus[64], ok[128], two_ok[128];",
+            "/* these kernels use no other: the registry stays out of this build */",
+            "const apair_kernel *apair_find_kernel(const char *name) { (void)name; return NULL; }",
+            "int main(void) {",
+            "    int size = 0, i;",
+            f"    if (apair_ik4_pencil({d3}, {d4}, C, Qf, af, Qg, ag, {pencil.LEAD_COND!r}, 3, {pencil.DEFLATE_TOL!r}, f, g, M, &size)) return 1;",
+            '    printf("size %d\\nM", size);',
+            '    for (i = 0; i < size * size; i++) printf(" %.17g", M[i]);',
+            f"    if (apair_ik4_screen({len(u3)}, u3, {d3}, {d4}, C, f, {f.shape[0] - 1}, {f.shape[1] - 1}, g, "
+            f"{g.shape[0] - 1}, {g.shape[1] - 1}, {len(elim.Q)}, Q, probe, stol, status, u4, Wo, rel, two, two_ok, W2, rel2))"
+            " return 2;",
+            f'    printf("\\ntwo"); for (i = 0; i < {4 * len(u3)}; i++) printf(" %.17g", two[i]);',
+            f'    printf("\\nrel2"); for (i = 0; i < {2 * len(u3)}; i++) printf(" %.17g", rel2[i]);',
+            f'    printf("\\nu4"); for (i = 0; i < {len(u3)}; i++) printf(" %.17g", u4[i]);',
+            f'    printf("\\nstatus"); for (i = 0; i < {len(u3)}; i++) printf(" %d", status[i]);',
+            f"    if (apair_ik4_left({len(W)}, W, {elim.Zmap.shape[0] - 1}, Zmap, {j2.P.shape[0] - 1}, P2, joint, ltol, "
+            "lstatus, u1, u2, ok)) return 3;",
+            f'    printf("\\nu1"); for (i = 0; i < {len(W)}; i++) printf(" %.17g", u1[i]);',
+            f'    printf("\\nu2"); for (i = 0; i < {2 * len(W)}; i++) printf(" %.17g", u2[i]);',
+            '    printf("\\n");',
+            "    return 0;",
+            "}",
+            "",
+        ]
+    )
     prog = tmp_path / "ik4.c"
     prog.write_text(src)
     exe = tmp_path / "ik4"
-    run(["gcc", "-std=c99", *STRICT, "-O1", *SANITIZE, f"-I{CDIR}", str(prog), str(CDIR / "apair_ik.c"),
-         str(CDIR / "ik_residual6.c"), "-lm", "-o", str(exe)])
+    run(
+        [
+            "gcc",
+            "-std=c99",
+            *STRICT,
+            "-O1",
+            *SANITIZE,
+            f"-I{CDIR}",
+            str(prog),
+            str(CDIR / "apair_ik.c"),
+            str(CDIR / "ik_residual6.c"),
+            "-lm",
+            "-o",
+            str(exe),
+        ]
+    )
     res = run([str(exe)], env={**os.environ, **SAN_ENV})
     assert res.stderr == ""
     out = {line.split()[0]: line.split()[1:] for line in res.stdout.splitlines()}

@@ -1,4 +1,5 @@
 """The `apair` command line, through apair.cli.main and once as `python -m apair`."""
+
 from __future__ import annotations
 
 import json
@@ -120,19 +121,22 @@ def test_demo_without_file(capsys):
     assert code == 0 and "consistency" in out and "Jacobian" not in out
 
 
-@pytest.mark.parametrize("argv, command, message", [
-    (["fk", CHAIN2, "0.1"], "fk", r"Q: 2A example has 2 joints, got 1 angles"),
-    (["fk", CHAIN2, "0.1", "0.2", "0.3"], "fk", r"Q: 2A example has 2 joints, got 3 angles"),
-    (["fk", CHAIN2, "0.1", "abc"], "fk", r"Q: 'abc' is not a number"),
-    (["fk", CHAIN2, "0.1", "nan"], "fk", r"q: contains NaN"),
-    (["show", "nope"], "show", r"name: no derived polynomial set 'nope'"),
-    (["show", "nope", "--json"], "show", r"name: no derived polynomial set 'nope'"),
-    (["fk", EXAMPLES / "missing.toml", "0.1"], "fk", r"path: no such file .*missing\.toml"),
-    (["demo", EXAMPLES / "missing.toml"], "demo", r"path: no such file .*missing\.toml"),
-    (["ik", CHAIN4, "1", "0", "0"], "ik", r"POSE: expected 16 \(or 12\) numbers"),
-    (["ik", CHAIN4, *"1 0 0 0 0 1 0 0 0 0 1 x".split()], "ik", r"POSE: 'x' is not a number"),
-    (["ik", CHAIN4, *"1 0 0 0 0 1 0 0 0 0 2 0".split()], "ik", r"T: the rotation part is not a proper rotation"),
-])
+@pytest.mark.parametrize(
+    "argv, command, message",
+    [
+        (["fk", CHAIN2, "0.1"], "fk", r"Q: 2A example has 2 joints, got 1 angles"),
+        (["fk", CHAIN2, "0.1", "0.2", "0.3"], "fk", r"Q: 2A example has 2 joints, got 3 angles"),
+        (["fk", CHAIN2, "0.1", "abc"], "fk", r"Q: 'abc' is not a number"),
+        (["fk", CHAIN2, "0.1", "nan"], "fk", r"q: contains NaN"),
+        (["show", "nope"], "show", r"name: no derived polynomial set 'nope'"),
+        (["show", "nope", "--json"], "show", r"name: no derived polynomial set 'nope'"),
+        (["fk", EXAMPLES / "missing.toml", "0.1"], "fk", r"path: no such file .*missing\.toml"),
+        (["demo", EXAMPLES / "missing.toml"], "demo", r"path: no such file .*missing\.toml"),
+        (["ik", CHAIN4, "1", "0", "0"], "ik", r"POSE: expected 16 \(or 12\) numbers"),
+        (["ik", CHAIN4, *"1 0 0 0 0 1 0 0 0 0 1 x".split()], "ik", r"POSE: 'x' is not a number"),
+        (["ik", CHAIN4, *"1 0 0 0 0 1 0 0 0 0 2 0".split()], "ik", r"T: the rotation part is not a proper rotation"),
+    ],
+)
 def test_error_exits(capsys, argv, command, message):
     code, out, err = run(capsys, *argv)
     assert code == 2
@@ -149,8 +153,9 @@ def test_bad_chain_file(capsys, tmp_path):
 
 
 def test_module_entry_point():
-    ok = subprocess.run([sys.executable, "-m", "apair", "fk", str(CHAIN2), "0.1", "0.2"],
-                        capture_output=True, text=True, timeout=120)
+    ok = subprocess.run(
+        [sys.executable, "-m", "apair", "fk", str(CHAIN2), "0.1", "0.2"], capture_output=True, text=True, timeout=120
+    )
     assert ok.returncode == 0, ok.stderr
     T = printed_block(ok.stdout, "T =", "Study point").reshape(4, 4)
     np.testing.assert_allclose(T, apair.load(CHAIN2).fk([0.1, 0.2]), atol=1e-11)
@@ -182,4 +187,3 @@ def test_ik_unreachable_says_how_far(capsys):
     m = re.search(rf"unreachable. The nearest pose found .* is ({NUMBER}) m and ({NUMBER}) rad away", out)
     assert m, out
     assert 0 < float(m.group(1)) <= 0.05 + 1e-9
-

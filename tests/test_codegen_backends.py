@@ -4,6 +4,7 @@ Quick checks of the structure (`make check` compares the whole of generated/ wit
 the lowering passes on a small spec, each backend's files from its own templates, the facade
 (codegen.emitter) giving the same files, and generated/c/apair_ik.c as a copy of src/csrc/apair_ik.c.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -30,8 +31,15 @@ def small_spec(**kw) -> KernelSpec:
     s1, s2 = sp.symbols("s1 s2", real=True)
     inputs = [Arg("q", (2,), "state", (x, y)), Arg("dh", (1,), "design", (a,), design=True)]
     outputs = [Arg("out", (2,), "result", exprs=(s2 * sp.cos(a), s2 + sp.cos(a) * x))]
-    return KernelSpec(kw.pop("name", "small"), "A small kernel.", "derivations/test.py", inputs, outputs,
-                      steps=[(s1, x * y), (s2, s1 + sp.sin(x))], **kw)
+    return KernelSpec(
+        kw.pop("name", "small"),
+        "A small kernel.",
+        "derivations/test.py",
+        inputs,
+        outputs,
+        steps=[(s1, x * y), (s2, s1 + sp.sin(x))],
+        **kw,
+    )
 
 
 def test_lowering_passes():
@@ -50,17 +58,23 @@ def test_lowering_passes():
     assert drop_unused([(t0, u + 1), (t1, u + 2)], [t1]) == [(t1, u + 2)]
     assert rename([(u, t0 + 1)], [u]) == ([(sp.Symbol("t0", real=True), t0 + 1)], [sp.Symbol("t0", real=True)])
     assert ordered([(t0, u + 1), (t1, t0 * 2)], [(u, sp.Symbol("v")), (sp.Symbol("w"), t1)]) == [
-        (u, sp.Symbol("v")), (t0, u + 1), (t1, 2 * t0), (sp.Symbol("w"), t1)]
+        (u, sp.Symbol("v")),
+        (t0, u + 1),
+        (t1, 2 * t0),
+        (sp.Symbol("w"), t1),
+    ]
 
 
 def test_symbol_check():
     x = sp.Symbol("q", real=True)  # a scalar named like its array is renamed
-    spec = KernelSpec("k", "doc", "derivations/test.py", [Arg("q", (1,), "q", (x,))],
-                      [Arg("out", (1,), "out", exprs=(x * 2,))])
+    spec = KernelSpec(
+        "k", "doc", "derivations/test.py", [Arg("q", (1,), "q", (x,))], [Arg("out", (1,), "out", exprs=(x * 2,))]
+    )
     assert local_names(spec)[x] == sp.Symbol("q_v", real=True)
     t = sp.Symbol("t3", real=True)
-    bad = KernelSpec("k", "doc", "derivations/test.py", [Arg("q", (1,), "q", (t,))],
-                     [Arg("out", (1,), "out", exprs=(t * 2,))])
+    bad = KernelSpec(
+        "k", "doc", "derivations/test.py", [Arg("q", (1,), "q", (t,))], [Arg("out", (1,), "out", exprs=(t * 2,))]
+    )
     with pytest.raises(ValueError, match="clashes with CSE temporaries"):
         lower(bad)
 

@@ -76,8 +76,9 @@ def test_a_linked_subfolder_is_refused(tmp_path):
     out.mkdir()
     (out / "sub").symlink_to(elsewhere)
     with pytest.raises(OutputError, match="symbolic link"):
-        write({"sub/x.c": "int x;\n", "manifest.json": json.dumps({"kernels": {}, "content_hash": "0"})}, out,
-              force=True)
+        write(
+            {"sub/x.c": "int x;\n", "manifest.json": json.dumps({"kernels": {}, "content_hash": "0"})}, out, force=True
+        )
     assert not (elsewhere / "x.c").exists()
 
 
@@ -89,8 +90,9 @@ def test_a_crafted_manifest_deletes_nothing_outside(tmp_path):
     absolute = tmp_path / "absolute.txt"
     absolute.write_text("keep me too\n")
     manifest = json.loads((out / "manifest.json").read_text())
-    manifest["files"] = dict(manifest["files"], **{"../victim.txt": None, str(absolute): None,
-                                                     "./one.c": None, "a/../../victim.txt": None})
+    manifest["files"] = dict(
+        manifest["files"], **{"../victim.txt": None, str(absolute): None, "./one.c": None, "a/../../victim.txt": None}
+    )
     (out / "manifest.json").write_text(json.dumps(manifest))
     assert codegen(out, "other") == 0  # the files of "one" are stale now
     assert victim.read_text() == "keep me\n" and absolute.read_text() == "keep me too\n"
@@ -130,10 +132,17 @@ sys.exit(main(["codegen", sys.argv[1], "--prefix", sys.argv[2], "--kernels", "fk
 def test_concurrent_runs_into_one_new_folder_take_turns(tmp_path, prefixes):
     for attempt in range(3):
         out = tmp_path / f"code{attempt}"
-        procs = [subprocess.Popen([sys.executable, "-c", RACE, EXAMPLE, p, str(out)], stdout=subprocess.PIPE,
-                                  stderr=subprocess.PIPE, text=True) for p in prefixes]
+        procs = [
+            subprocess.Popen(
+                [sys.executable, "-c", RACE, EXAMPLE, p, str(out)],
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+            for p in prefixes
+        ]
         results = [p.communicate(timeout=300) + (p.returncode,) for p in procs]
-        for stdout, stderr, rc in results:
+        for _stdout, stderr, rc in results:
             assert rc == 0, stderr
         files = json.loads((out / "manifest.json").read_text())["files"]
         last = files and next(iter(files))

@@ -1,4 +1,5 @@
 """Collision limits of A-pairs: exact root isolation checked against dense scans of the clearance."""
+
 from __future__ import annotations
 
 import math
@@ -28,6 +29,7 @@ def test_segment_distance_against_brute_force():
 def _scan(pair, sign, stop):
     """First θ (in direction sign) where the clearance reaches zero: a grid of 4001 points, then
     bisection to 1e-13 — independent of the polynomials."""
+
     def clearance(th):
         legs, plate = C.clearances(pair, np.asarray(th))
         return np.minimum(legs.min(axis=-1), plate)
@@ -51,8 +53,13 @@ def random_pair(rng, kind):
         lo = math.sqrt(max(rb**2 + rp**2 / 4 - rb * rp, 0.0))
         pair = apair.APair(rb, rp, leg_length=lo + rng.uniform(0.01, 1.5) * (rb + rp))
     free = C.clearances(pair, np.array(0.0))[0].min()
-    return apair.APair(rb, rp, None if kind == "sinusoidal" else pair.leg_lengths[0],
-                       leg_radius=rng.uniform(0.0, 0.45) * free, thickness=rng.uniform(0.0, 0.95) * pair.translation(0.0))
+    return apair.APair(
+        rb,
+        rp,
+        None if kind == "sinusoidal" else pair.leg_lengths[0],
+        leg_radius=rng.uniform(0.0, 0.45) * free,
+        thickness=rng.uniform(0.0, 0.95) * pair.translation(0.0),
+    )
 
 
 @pytest.mark.parametrize("kind", ["sinusoidal", "general"])
@@ -126,12 +133,14 @@ def test_chain_limits_from_pairs_and_files(tmp_path):
     narrow = apair.AChain([pair, apair.APair.revolute()], [0.2, 0.1], [0.5, 0.0], limits=[(-0.5, 0.5), None])
     assert np.allclose(narrow.limits[0], [-0.5, 0.5])
     with pytest.raises(ValueError, match=r"limits\[0\].*collision-free"):
-        apair.AChain([pair], [0.2], [0.5], limits=[(-4.0, 0.5)]).limits
+        apair.AChain([pair], [0.2], [0.5], limits=[(-4.0, 0.5)]).limits  # noqa: B018 (the access raises)
     with pytest.raises(ValueError, match=r"limits\[0\]"):
         apair.AChain([pair], [0.2], [0.5], limits=[(0.5, -0.5)])
     f = tmp_path / "c.toml"
-    f.write_text('[[joint]]\npair = "sinusoidal"\nbase_radius = 0.05\nplatform_radius = 0.05\nleg_radius = 0.002\n'
-                 'thickness = 0.001\nlimits_deg = [-30, 45]\na = 0.2\nalpha = 0.5\n')
+    f.write_text(
+        '[[joint]]\npair = "sinusoidal"\nbase_radius = 0.05\nplatform_radius = 0.05\nleg_radius = 0.002\n'
+        "thickness = 0.001\nlimits_deg = [-30, 45]\na = 0.2\nalpha = 0.5\n"
+    )
     c = apair.load(f)
     assert np.allclose(c.limits, [[-math.pi / 6, math.pi / 4]]) and c.pairs[0].thickness == 0.001
     f.write_text(f.read_text().replace("limits_deg = [-30, 45]", "limits = [-1.0]"))
@@ -149,8 +158,10 @@ def test_clearance_plot_and_cli(tmp_path, capsys):
     with pytest.raises(ValueError, match="exists"):
         clearance(pair, out)
     f = tmp_path / "c.toml"
-    f.write_text('[[joint]]\npair = "sinusoidal"\nbase_radius = 0.05\nplatform_radius = 0.04\nleg_radius = 0.003\n'
-                 'a = 0.2\nalpha = 0.5\n[[joint]]\npair = "revolute"\na = 0.1\nalpha = 0\n')
+    f.write_text(
+        '[[joint]]\npair = "sinusoidal"\nbase_radius = 0.05\nplatform_radius = 0.04\nleg_radius = 0.003\n'
+        'a = 0.2\nalpha = 0.5\n[[joint]]\npair = "revolute"\na = 0.1\nalpha = 0\n'
+    )
     assert main(["limits", str(f), "--plot", str(tmp_path / "d.png")]) == 0
     text = capsys.readouterr().out
     lim = pair.collision_limits()

@@ -1,4 +1,5 @@
 """The derivations against the known results of docs/conventions.md §2, and generated/ against them."""
+
 from __future__ import annotations
 
 import os
@@ -76,13 +77,30 @@ def test_generation_is_deterministic(seed, tmp_path):
     """Regenerating under another hash seed gives the same files byte for byte (two of the
     derivations, to keep the suite quick; `make check` compares everything with generated/)."""
     env = dict(os.environ, PYTHONHASHSEED=seed, PYTHONPATH=str(ROOT))
-    res = subprocess.run([sys.executable, "-m", "codegen", "--out", str(tmp_path), "--only", "apair_pair",
-                          "chain_kinematics"], cwd=ROOT, env=env, capture_output=True, text=True)
+    res = subprocess.run(
+        [sys.executable, "-m", "codegen", "--out", str(tmp_path), "--only", "apair_pair", "chain_kinematics"],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+    )
     assert res.returncode == 0, res.stderr
     fresh = {p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file()}
-    own = {rel for rel in fresh if rel.parts[0] in ("c", "numpy", "polynomials") and rel.name not in
-           ("apair.h", "apair_internal.h", "apair_registry.c", "apair_ik.c", "CMakeLists.txt", "apair.pc.in",
-            "__init__.py")}  # indexes of all, and the solvers (sized by the whole set)
+    own = {
+        rel
+        for rel in fresh
+        if rel.parts[0] in ("c", "numpy", "polynomials")
+        and rel.name
+        not in (
+            "apair.h",
+            "apair_internal.h",
+            "apair_registry.c",
+            "apair_ik.c",
+            "CMakeLists.txt",
+            "apair.pc.in",
+            "__init__.py",
+        )
+    }  # indexes of all, and the solvers (sized by the whole set)
     assert len(own) >= 10
     for rel in sorted(own):
         assert (tmp_path / rel).read_bytes() == (ROOT / "generated" / rel).read_bytes(), rel
@@ -103,15 +121,26 @@ def test_chain2_study_polynomials_are_the_kernel(backend):
 
     eqs = apair.polynomials.load("chain2_study")
     rng = np.random.default_rng(8)
-    chain = apair.AChain([apair.APair(0.3, 0.5), apair.APair(0.4, 0.2, leg_length=0.45)],
-                         rng.uniform(-1, 1, 2), rng.uniform(-3, 3, 2), rng.uniform(-1, 1, 2), rng.uniform(-3, 3, 2))
+    chain = apair.AChain(
+        [apair.APair(0.3, 0.5), apair.APair(0.4, 0.2, leg_length=0.45)],
+        rng.uniform(-1, 1, 2),
+        rng.uniform(-3, 3, 2),
+        rng.uniform(-1, 1, 2),
+        rng.uniform(-3, 3, 2),
+    )
     q = rng.uniform(-1, 1, 2)
     d = [p.translation(x) for p, x in zip(chain.pairs, q)]
     values = {}
     for i in range(2):
         ht, ha = (q[i] + chain.theta_offset[i]) / 2, chain.alpha[i] / 2
-        for name, v in [("C", np.cos(ht)), ("S", np.sin(ht)), ("K", np.cos(ha)), ("L", np.sin(ha)),
-                        ("a", chain.a[i]), ("D", chain.offset[i] + d[i])]:
+        for name, v in [
+            ("C", np.cos(ht)),
+            ("S", np.sin(ht)),
+            ("K", np.cos(ha)),
+            ("L", np.sin(ha)),
+            ("a", chain.a[i]),
+            ("D", chain.offset[i] + d[i]),
+        ]:
             values[sp.Symbol(f"{name}_{i + 1}", real=True)] = v
     got = np.array([float(eqs[n].xreplace(values)) for n in ("x0", "x1", "x2", "x3", "y0", "y1", "y2", "y3")])
     want = chain.fk_study(q)

@@ -1,5 +1,6 @@
 """Dynamics of A-chains: against Pinocchio (R-chains, and A-pairs as coupled RZ+PZ joints),
 against an independent finite-difference energy with legs, and the structural identities."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -34,9 +35,15 @@ def random_chain(rng, n, kinds=("sinusoidal", "general", "revolute"), legs=False
             b = r_b * r_p
             a = b * rng.uniform(1.2, 3.0)  # a > b: every angle is reachable
             pairs.append(apair.APair(r_b, r_p, leg_length=np.sqrt(a + r_b**2 + r_p**2 / 4), leg_mass=ml))
-    return apair.AChain(pairs, rng.uniform(-0.5, 0.5, n), rng.uniform(-np.pi, np.pi, n), rng.uniform(-0.3, 0.3, n),
-                        rng.uniform(-np.pi, np.pi, n), links=[random_link(rng) for _ in range(n)],
-                        gravity=rng.normal(size=3) * 5)
+    return apair.AChain(
+        pairs,
+        rng.uniform(-0.5, 0.5, n),
+        rng.uniform(-np.pi, np.pi, n),
+        rng.uniform(-0.3, 0.3, n),
+        rng.uniform(-np.pi, np.pi, n),
+        links=[random_link(rng) for _ in range(n)],
+        gravity=rng.normal(size=3) * 5,
+    )
 
 
 def pinocchio_model(chain: apair.AChain):
@@ -49,8 +56,12 @@ def pinocchio_model(chain: apair.AChain):
         if p.kind != "revolute":
             parent = model.addJoint(parent, pin.JointModelPZ(), pin.SE3.Identity(), f"p{i}")
         a, alpha, c, phi = chain.a[i], chain.alpha[i], chain.offset[i], chain.theta_offset[i]
-        D = (pin.SE3(pin.utils.rotate("z", phi), np.zeros(3)) * pin.SE3(np.eye(3), np.array([0, 0, c]))
-             * pin.SE3(np.eye(3), np.array([a, 0, 0])) * pin.SE3(pin.utils.rotate("x", alpha), np.zeros(3)))
+        D = (
+            pin.SE3(pin.utils.rotate("z", phi), np.zeros(3))
+            * pin.SE3(np.eye(3), np.array([0, 0, c]))
+            * pin.SE3(np.eye(3), np.array([a, 0, 0]))
+            * pin.SE3(pin.utils.rotate("x", alpha), np.zeros(3))
+        )
         L = chain.links[i]
         model.appendBodyToJoint(parent, D.act(pin.Inertia(L.mass, L.com, L.inertia)), pin.SE3.Identity())
         placement = D
@@ -61,7 +72,7 @@ def pinocchio_model(chain: apair.AChain):
 def reduced(chain, q, qd, qdd):
     """Full coordinates of the Pinocchio model and the coupling S, Ṡθ' (d_i = d_i(θ_i))."""
     law = chain.law(q)
-    cols, qf, qdf, qddf = [], [], [], []
+    qf = []
     nf = sum(1 if p.kind == "revolute" else 2 for p in chain.pairs)
     S = np.zeros((nf, chain.n))
     Sdqd = np.zeros(nf)
@@ -92,17 +103,25 @@ def test_revolute_chain_equals_pinocchio(n, backend):
             np.testing.assert_allclose(chain.mass_matrix(q), Mp, atol=1e-9)
             np.testing.assert_allclose(chain.bias(q, qd), pin.rnea(model, data, q, qd, np.zeros(n)), atol=1e-9)
             np.testing.assert_allclose(chain.inverse_dynamics(q, qd, qdd), pin.rnea(model, data, q, qd, qdd), atol=1e-9)
-            np.testing.assert_allclose(chain.gravity_torques(q), pin.computeGeneralizedGravity(model, data, q), atol=1e-9)
+            np.testing.assert_allclose(
+                chain.gravity_torques(q), pin.computeGeneralizedGravity(model, data, q), atol=1e-9
+            )
 
 
 def special_chain(rng, n) -> apair.AChain:
     """The constants real robots use: twists 0 and ±90°, lengths, offsets and angle offsets 0 or
     round values (intersecting and parallel axes), sinusoidal A-pairs with massive legs and R-pairs."""
-    pairs = [apair.APair.revolute() if rng.random() < 0.4 else apair.APair(0.05, 0.04, leg_mass=0.1)
-             for _ in range(n)]
+    pairs = [apair.APair.revolute() if rng.random() < 0.4 else apair.APair(0.05, 0.04, leg_mass=0.1) for _ in range(n)]
     pick = lambda values: rng.choice(values, n)
-    return apair.AChain(pairs, pick([0.0, 0.1, 0.3]), pick([0.0, np.pi / 2, -np.pi / 2]), pick([0.0, 0.1]),
-                        pick([0.0, np.pi / 2]), links=[random_link(rng) for _ in range(n)], gravity=(0.0, 0.0, -9.81))
+    return apair.AChain(
+        pairs,
+        pick([0.0, 0.1, 0.3]),
+        pick([0.0, np.pi / 2, -np.pi / 2]),
+        pick([0.0, 0.1]),
+        pick([0.0, np.pi / 2]),
+        links=[random_link(rng) for _ in range(n)],
+        gravity=(0.0, 0.0, -9.81),
+    )
 
 
 @pytest.mark.parametrize("n", [2, 4, 6])
@@ -112,9 +131,15 @@ def test_special_designs_equal_reduced_pinocchio(n, backend):
     rng = np.random.default_rng(300 + n)
     for _ in range(6):
         chain = special_chain(rng, n)
-        plain = apair.AChain([apair.APair(0.05, 0.04) if p.kind != "revolute" else p for p in chain.pairs],
-                             chain.a, chain.alpha, chain.offset, chain.theta_offset, links=chain.links,
-                             gravity=chain.gravity)
+        plain = apair.AChain(
+            [apair.APair(0.05, 0.04) if p.kind != "revolute" else p for p in chain.pairs],
+            chain.a,
+            chain.alpha,
+            chain.offset,
+            chain.theta_offset,
+            links=chain.links,
+            gravity=chain.gravity,
+        )
         model = pinocchio_model(plain)
         data = model.createData()
         for _ in range(3):
@@ -131,8 +156,9 @@ def test_special_designs_equal_reduced_pinocchio(n, backend):
             # the legs only add: their mass matrix is the plain one plus a positive semidefinite part
             extra = np.linalg.eigvalsh(chain.mass_matrix(q) - plain.mass_matrix(q))
             assert extra.min() > -1e-12
-            np.testing.assert_allclose(chain.forward_dynamics(q, qd, chain.inverse_dynamics(q, qd, qdd)), qdd,
-                                       atol=1e-7)
+            np.testing.assert_allclose(
+                chain.forward_dynamics(q, qd, chain.inverse_dynamics(q, qd, qdd)), qdd, atol=1e-7
+            )
 
 
 @pytest.mark.parametrize("n", N_RANGE)
@@ -229,8 +255,9 @@ def test_structure_with_legs(n, backend):
         N = Mdot - 2 * chain.coriolis_matrix(q, qd)
         np.testing.assert_allclose(N + N.T, 0, atol=1e-6 * max(1, np.abs(Mdot).max()))
         # C θ' + g is the bias; ∂τ/∂θ'' is M (τ is affine in θ'')
-        np.testing.assert_allclose(chain.coriolis_matrix(q, qd) @ qd + chain.gravity_torques(q), chain.bias(q, qd),
-                                   atol=1e-10)
+        np.testing.assert_allclose(
+            chain.coriolis_matrix(q, qd) @ qd + chain.gravity_torques(q), chain.bias(q, qd), atol=1e-10
+        )
         tau0 = chain.inverse_dynamics(q, qd, qdd)
         J = np.stack([chain.inverse_dynamics(q, qd, qdd + e) - tau0 for e in np.eye(n)], axis=1)
         np.testing.assert_allclose(J, M, atol=1e-9)

@@ -1,5 +1,6 @@
 """Dynamics inputs: Link, links, gravity, states, simulate, the single-pair API, chain files with
 inertia, and the worked example."""
+
 from __future__ import annotations
 
 import subprocess
@@ -14,17 +15,20 @@ import apair
 ROOT = Path(__file__).resolve().parent.parent
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"mass": -1.0}, r"^mass: must be >= 0"),
-    ({"mass": np.nan}, r"^mass:"),
-    ({"mass": 1.0, "com": [0, 0]}, r"^com: expected shape \(3,\)"),
-    ({"mass": 1.0, "com": [0, np.inf, 0]}, r"^com:"),
-    ({"mass": 1.0, "inertia": np.eye(2)}, r"^inertia: expected shape \(3, 3\)"),
-    ({"mass": 1.0, "inertia": [[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]}, r"^inertia: must be symmetric"),
-    ({"mass": 1.0, "inertia": np.diag([1.0, 1.0, -0.1])}, r"^inertia: must be positive semi-definite"),
-    ({"mass": 1.0, "inertia": np.diag([0.1, 0.1, 1.0])}, r"^inertia: .*triangle inequality"),
-    ({"mass": 1.0, "inertia": [[1, 0, 0], [0, 1, 0], [0, 0, np.nan]]}, r"^inertia:"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"mass": -1.0}, r"^mass: must be >= 0"),
+        ({"mass": np.nan}, r"^mass:"),
+        ({"mass": 1.0, "com": [0, 0]}, r"^com: expected shape \(3,\)"),
+        ({"mass": 1.0, "com": [0, np.inf, 0]}, r"^com:"),
+        ({"mass": 1.0, "inertia": np.eye(2)}, r"^inertia: expected shape \(3, 3\)"),
+        ({"mass": 1.0, "inertia": [[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]}, r"^inertia: must be symmetric"),
+        ({"mass": 1.0, "inertia": np.diag([1.0, 1.0, -0.1])}, r"^inertia: must be positive semi-definite"),
+        ({"mass": 1.0, "inertia": np.diag([0.1, 0.1, 1.0])}, r"^inertia: .*triangle inequality"),
+        ({"mass": 1.0, "inertia": [[1, 0, 0], [0, 1, 0], [0, 0, np.nan]]}, r"^inertia:"),
+    ],
+)
 def test_link_rejects(kwargs, match):
     with pytest.raises(ValueError, match=match):
         apair.Link(**kwargs)
@@ -38,37 +42,46 @@ def test_link_accepts_physical_bodies():
 
 def chain2(**kw):
     pairs = [apair.APair(0.1, 0.1, leg_mass=0.1), apair.APair.revolute()]
-    links = [apair.Link(1.0, [0, 0, 0.05], np.diag([0.01, 0.01, 0.02])), apair.Link(0.5, [0.1, 0, 0], np.diag([0.001, 0.002, 0.002]))]
+    links = [
+        apair.Link(1.0, [0, 0, 0.05], np.diag([0.01, 0.01, 0.02])),
+        apair.Link(0.5, [0.1, 0, 0], np.diag([0.001, 0.002, 0.002])),
+    ]
     args = dict(links=links)
     args.update(kw)
     return apair.AChain(pairs, [0.3, 0.2], [np.pi / 2, 0.0], **args)
 
 
-@pytest.mark.parametrize("kw, match", [
-    ({"links": [apair.Link(1.0)]}, r"^links: expected 2 links"),
-    ({"links": [apair.Link(1.0), "x"]}, r"^links\[1\]: expected a Link"),
-    ({"links": 3}, r"^links: expected a sequence"),
-    ({"gravity": [0, 0]}, r"^gravity: expected shape \(3,\)"),
-    ({"gravity": [0, 0, np.nan]}, r"^gravity:"),
-])
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        ({"links": [apair.Link(1.0)]}, r"^links: expected 2 links"),
+        ({"links": [apair.Link(1.0), "x"]}, r"^links\[1\]: expected a Link"),
+        ({"links": 3}, r"^links: expected a sequence"),
+        ({"gravity": [0, 0]}, r"^gravity: expected shape \(3,\)"),
+        ({"gravity": [0, 0, np.nan]}, r"^gravity:"),
+    ],
+)
 def test_chain_dynamics_arguments(kw, match):
     with pytest.raises(ValueError, match=match):
         chain2(**kw)
 
 
-@pytest.mark.parametrize("call, match", [
-    (lambda c: c.bias([0.1, 0.2], [0.1]), r"^qd: expected shape"),
-    (lambda c: c.inverse_dynamics([0.1, 0.2], [0.1, 0.2], [[0.1, 0.2, 0.3]]), r"^qdd: expected shape"),
-    (lambda c: c.inverse_dynamics(np.zeros((3, 2)), np.zeros((4, 2)), np.zeros(2)), r"^qd: batch shape"),
-    (lambda c: c.forward_dynamics([0.1, 0.2], [0, 0], [np.inf, 0]), r"^tau:"),
-    (lambda c: c.mass_matrix([np.nan, 0.0]), r"^q:"),
-    (lambda c: c.simulate([0, 0], [0, 0], [0.0]), r"^t: expected at least two"),
-    (lambda c: c.simulate([0, 0], [0, 0], [0.0, 1.0, 0.5]), r"^t: output times must increase"),
-    (lambda c: c.simulate([0, 0], [0, 0, 0], [0.0, 1.0]), r"^qd0: expected shape"),
-    (lambda c: c.simulate([0, 0], [0, 0], [0.0, 1.0], tau=[1.0]), r"^tau: expected shape"),
-    (lambda c: c.simulate([0, 0], [0, 0], [0.0, 1.0], tau=lambda t, q, qd: np.zeros(3)), r"^tau: the callable"),
-    (lambda c: c.simulate([0, 0], [0, 0], [0.0, 1.0], rtol=-1), r"^rtol:"),
-])
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda c: c.bias([0.1, 0.2], [0.1]), r"^qd: expected shape"),
+        (lambda c: c.inverse_dynamics([0.1, 0.2], [0.1, 0.2], [[0.1, 0.2, 0.3]]), r"^qdd: expected shape"),
+        (lambda c: c.inverse_dynamics(np.zeros((3, 2)), np.zeros((4, 2)), np.zeros(2)), r"^qd: batch shape"),
+        (lambda c: c.forward_dynamics([0.1, 0.2], [0, 0], [np.inf, 0]), r"^tau:"),
+        (lambda c: c.mass_matrix([np.nan, 0.0]), r"^q:"),
+        (lambda c: c.simulate([0, 0], [0, 0], [0.0]), r"^t: expected at least two"),
+        (lambda c: c.simulate([0, 0], [0, 0], [0.0, 1.0, 0.5]), r"^t: output times must increase"),
+        (lambda c: c.simulate([0, 0], [0, 0, 0], [0.0, 1.0]), r"^qd0: expected shape"),
+        (lambda c: c.simulate([0, 0], [0, 0], [0.0, 1.0], tau=[1.0]), r"^tau: expected shape"),
+        (lambda c: c.simulate([0, 0], [0, 0], [0.0, 1.0], tau=lambda t, q, qd: np.zeros(3)), r"^tau: the callable"),
+        (lambda c: c.simulate([0, 0], [0, 0], [0.0, 1.0], rtol=-1), r"^rtol:"),
+    ],
+)
 def test_dynamics_call_rejects(call, match):
     with pytest.raises(ValueError, match=match):
         call(chain2())

@@ -4,6 +4,7 @@ Every bad input here ends in a one-line message that names the argument (or, on 
 a non-zero exit with such a line on stderr); no picture or generated file a user owns is replaced
 or deleted without being asked.
 """
+
 from __future__ import annotations
 
 import os
@@ -19,8 +20,9 @@ from apair import cli, plots
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE = ROOT / "examples" / "4a_chain.toml"
-GENERAL = ('[[joint]]\npair = "general"\nbase_radius = 0.05\nplatform_radius = 0.04\nleg_length = 0.06\n'
-           'a = 0.1\nalpha = 0\n')
+GENERAL = (
+    '[[joint]]\npair = "general"\nbase_radius = 0.05\nplatform_radius = 0.04\nleg_length = 0.06\na = 0.1\nalpha = 0\n'
+)
 
 
 def run_cli(capsys, *argv):
@@ -80,8 +82,13 @@ def test_workspace_plot_refused_before_the_run(tmp_path, capsys):
 def test_codegen_refuses_a_folder_it_did_not_create(tmp_path):
     mine = tmp_path / "notes.txt"
     mine.write_text("keep me")
-    res = subprocess.run([sys.executable, "-m", "codegen", "--out", str(tmp_path), "--only", "apair_collisions"],
-                         cwd=ROOT, capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    res = subprocess.run(
+        [sys.executable, "-m", "codegen", "--out", str(tmp_path), "--only", "apair_collisions"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        env=dict(os.environ, PYTHONPATH=str(ROOT)),
+    )
     assert res.returncode == 2 and "not written by codegen" in res.stderr and "Traceback" not in res.stderr
     assert mine.read_text() == "keep me" and sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
 
@@ -90,8 +97,7 @@ def test_codegen_clean_removes_only_its_own_files(tmp_path):
     from codegen.emitter import write
 
     out = tmp_path / "gen"
-    files = {"manifest.json": '{"content_hash": "x", "kernels": {}, "files": ["a.txt", "manifest.json"]}',
-             "a.txt": "a"}
+    files = {"manifest.json": '{"content_hash": "x", "kernels": {}, "files": ["a.txt", "manifest.json"]}', "a.txt": "a"}
     write(files, out)
     (out / "users.txt").write_text("keep me")
     write({"manifest.json": '{"content_hash": "x", "kernels": {}, "files": ["manifest.json"]}'}, out)
@@ -100,12 +106,20 @@ def test_codegen_clean_removes_only_its_own_files(tmp_path):
 
 
 # ----------------------------------------------------------------------------- item 10: clear errors
-@pytest.mark.parametrize("text, words", [
-    (GENERAL.replace("a = 0.1", "a = 1" + "0" * 400), ["joint 1.a", "too large"]),
-    ("x = " + "[" * 3000 + "]" * 3000 + "\n", ["nested too deeply"]),
-    ("\ufeff" + GENERAL.replace("general", "revolute").replace(
-        "base_radius = 0.05\nplatform_radius = 0.04\nleg_length = 0.06\n", ""), None),  # a BOM is fine
-])
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        (GENERAL.replace("a = 0.1", "a = 1" + "0" * 400), ["joint 1.a", "too large"]),
+        ("x = " + "[" * 3000 + "]" * 3000 + "\n", ["nested too deeply"]),
+        (
+            "\ufeff"
+            + GENERAL.replace("general", "revolute").replace(
+                "base_radius = 0.05\nplatform_radius = 0.04\nleg_length = 0.06\n", ""
+            ),
+            None,
+        ),  # a BOM is fine
+    ],
+)
 def test_chain_files_that_used_to_raise(tmp_path, capsys, text, words):
     f = tmp_path / "c.toml"
     f.write_text(text, encoding="utf-8")
@@ -131,15 +145,22 @@ def test_unreachable_scheduler_and_bogus_engine(capsys):
     chain = apair.load(EXAMPLE)
     with pytest.raises(ValueError, match="^engine: expected"):
         chain.workspace(samples=4000, engine="bogus")
-    code, _, err = run_cli(capsys, "workspace", EXAMPLE, "--scheduler", "tcp://127.0.0.1:9", "--quiet",
-                           "--samples", "4000")
+    code, _, err = run_cli(
+        capsys, "workspace", EXAMPLE, "--scheduler", "tcp://127.0.0.1:9", "--quiet", "--samples", "4000"
+    )
     assert_one_line_error(code, err, "engine: cannot reach a Dask scheduler")
 
 
-@pytest.mark.parametrize("kwargs, name", [
-    (dict(rounds=0.5), "rounds"), (dict(resolution=8.9), "resolution"), (dict(samples=1e4 + 0.5), "samples"),
-    (dict(resolution=3000), "resolution"), (dict(rounds=True), "rounds"),
-])
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        (dict(rounds=0.5), "rounds"),
+        (dict(resolution=8.9), "resolution"),
+        (dict(samples=1e4 + 0.5), "samples"),
+        (dict(resolution=3000), "resolution"),
+        (dict(rounds=True), "rounds"),
+    ],
+)
 def test_workspace_arguments_are_checked_not_truncated(kwargs, name):
     chain = apair.load(EXAMPLE)
     with pytest.raises(ValueError, match=f"^{name}: "):
@@ -151,8 +172,11 @@ def test_too_many_dimensions_and_complex_values_are_refused():
     deep = np.zeros((1,) * 30 + (4,))
     with pytest.raises(ValueError, match="^q: expected at most"):
         chain.fk(deep)
-    for call in (lambda: chain.fk(np.zeros(4) + 1j), lambda: apair.APair(0.05 + 0j, 0.04),
-                 lambda: chain.ik(chain.fk(np.zeros(4)) + 0j)):
+    for call in (
+        lambda: chain.fk(np.zeros(4) + 1j),
+        lambda: apair.APair(0.05 + 0j, 0.04),
+        lambda: chain.ik(chain.fk(np.zeros(4)) + 0j),
+    ):
         with pytest.raises(ValueError, match="real numbers"):
             call()
 
@@ -185,9 +209,23 @@ def test_unreachable_pose_is_reported_inside_the_limits_and_flagged(capsys):
 
 # ----------------------------------------------------------------------------- item 17: no compiler
 def _build(tmp_path, **env):
-    return subprocess.run([sys.executable, "setup.py", "-q", "build_ext", "--build-lib", str(tmp_path / "lib"),
-                           "--build-temp", str(tmp_path / "tmp")], cwd=ROOT, capture_output=True, text=True,
-                          env=dict(os.environ, **env), timeout=300)
+    return subprocess.run(
+        [
+            sys.executable,
+            "setup.py",
+            "-q",
+            "build_ext",
+            "--build-lib",
+            str(tmp_path / "lib"),
+            "--build-temp",
+            str(tmp_path / "tmp"),
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        env=dict(os.environ, **env),
+        timeout=300,
+    )
 
 
 def test_a_missing_compiler_is_said_at_install_time(tmp_path):
@@ -209,6 +247,9 @@ def test_joints_and_legs_are_numbered_from_one(capsys):
 
 
 def test_import_apair_gives_plots():
-    res = subprocess.run([sys.executable, "-c", "import apair; print(apair.plots.chain_picture.__name__)"],
-                         capture_output=True, text=True)
+    res = subprocess.run(
+        [sys.executable, "-c", "import apair; print(apair.plots.chain_picture.__name__)"],
+        capture_output=True,
+        text=True,
+    )
     assert res.returncode == 0 and res.stdout.strip() == "chain_picture"

@@ -1,4 +1,5 @@
 """Layers 2-4: identities and geometry of pairs and chains, on random designs, for both backends."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -23,8 +24,13 @@ def random_pair(rng: np.random.Generator, kind: str) -> apair.APair:
 
 def random_chain(rng: np.random.Generator, n: int, kinds=("sinusoidal", "general", "revolute")) -> apair.AChain:
     pairs = [random_pair(rng, rng.choice(kinds)) for _ in range(n)]
-    return apair.AChain(pairs, rng.uniform(-1, 1, n), rng.uniform(-np.pi, np.pi, n),
-                        rng.uniform(-1, 1, n), rng.uniform(-np.pi, np.pi, n))
+    return apair.AChain(
+        pairs,
+        rng.uniform(-1, 1, n),
+        rng.uniform(-np.pi, np.pi, n),
+        rng.uniform(-1, 1, n),
+        rng.uniform(-np.pi, np.pi, n),
+    )
 
 
 def random_q(rng: np.random.Generator, chain: apair.AChain, count: int) -> np.ndarray:
@@ -168,10 +174,9 @@ def test_jacobian_matches_finite_differences(n, backend):
 def dh_reference(a, alpha, d, theta):
     """Textbook standard-DH transform, written independently of the derivations."""
     ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-    return np.array([[ct, -st * ca, st * sa, a * ct],
-                     [st, ct * ca, -ct * sa, a * st],
-                     [0.0, sa, ca, d],
-                     [0.0, 0.0, 0.0, 1.0]])
+    return np.array(
+        [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]]
+    )
 
 
 @pytest.mark.parametrize("n", range(1, 7))

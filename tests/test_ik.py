@@ -1,4 +1,5 @@
 """Inverse kinematics by kinematic mapping (apair.ik): completeness, exactness, clear failures."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -11,10 +12,13 @@ from apair.study import conjugate, from_matrix, multiply
 
 
 def random_chain(rng, n, kinds="s") -> apair.AChain:
-    pairs = [apair.APair.revolute() if kinds[i % len(kinds)] == "r" else apair.APair(*rng.uniform(0.03, 0.1, 2))
-             for i in range(n)]
-    return apair.AChain(pairs, rng.uniform(0.1, 0.4, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.1, 0.1, n),
-                        rng.uniform(-1.0, 1.0, n))
+    pairs = [
+        apair.APair.revolute() if kinds[i % len(kinds)] == "r" else apair.APair(*rng.uniform(0.03, 0.1, 2))
+        for i in range(n)
+    ]
+    return apair.AChain(
+        pairs, rng.uniform(0.1, 0.4, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.1, 0.1, n), rng.uniform(-1.0, 1.0, n)
+    )
 
 
 def periods(chain):
@@ -46,8 +50,10 @@ def test_round_trip_random_4a_designs():
     assert found == 200
 
 
-@pytest.mark.parametrize("n, kinds", [(1, "s"), (1, "r"), (2, "s"), (2, "r"), (2, "sr"), (3, "s"), (3, "rs"),
-                                      (4, "r"), (4, "sr"), (4, "ssrs")])
+@pytest.mark.parametrize(
+    "n, kinds",
+    [(1, "s"), (1, "r"), (2, "s"), (2, "r"), (2, "sr"), (3, "s"), (3, "rs"), (4, "r"), (4, "sr"), (4, "ssrs")],
+)
 def test_round_trip_mixed_chains(n, kinds):
     rng = np.random.default_rng(n * 100 + len(kinds))
     for _ in range(8):
@@ -145,15 +151,18 @@ def test_near_singular_pose_is_solved_or_refused_never_wrong():
         assert contains(sols, q, periods(chain))
 
 
-@pytest.mark.parametrize("T, message", [
-    (np.eye(3), r"T: expected a 4x4 transform or an 8-vector Study point"),
-    (np.full((4, 4), np.nan), r"T: contains NaN"),
-    (np.diag([1.0, 1.0, 2.0, 1.0]), r"T: the rotation part is not a proper rotation"),
-    (np.diag([1.0, 1.0, -1.0, 1.0]), r"T: the rotation part is not a proper rotation"),
-    (np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]), r"T: last row"),
-    (np.array([1.0, 0, 0, 0, 1.0, 0, 0, 0]), r"T: not on the Study quadric"),
-    (np.zeros(8), r"T: a Study point with x = 0"),
-])
+@pytest.mark.parametrize(
+    "T, message",
+    [
+        (np.eye(3), r"T: expected a 4x4 transform or an 8-vector Study point"),
+        (np.full((4, 4), np.nan), r"T: contains NaN"),
+        (np.diag([1.0, 1.0, 2.0, 1.0]), r"T: the rotation part is not a proper rotation"),
+        (np.diag([1.0, 1.0, -1.0, 1.0]), r"T: the rotation part is not a proper rotation"),
+        (np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]), r"T: last row"),
+        (np.array([1.0, 0, 0, 0, 1.0, 0, 0, 0]), r"T: not on the Study quadric"),
+        (np.zeros(8), r"T: a Study point with x = 0"),
+    ],
+)
 def test_bad_pose(T, message):
     chain = random_chain(np.random.default_rng(0), 2)
     with pytest.raises(ValueError, match=message):
@@ -201,7 +210,7 @@ def special_angles(rng, n):
 
 def test_issue_reproducer_special_4r():
     R = apair.APair.revolute()
-    chain = apair.AChain([R] * 4, a=[.3, .3, .3, 0], alpha=[-np.pi / 2, -np.pi / 2, np.pi / 2, 0])
+    chain = apair.AChain([R] * 4, a=[0.3, 0.3, 0.3, 0], alpha=[-np.pi / 2, -np.pi / 2, np.pi / 2, 0])
     q = np.array([0.1, 0.2, 0.0, 0.4])
     sol = chain.ik(chain.fk(q), full=True)
     assert contains(sol.q, q, periods(chain)) and sol.certified

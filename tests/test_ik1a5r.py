@@ -2,6 +2,7 @@
 the generated equations at random poses against the DH product, the same solutions as the
 homotopy with the A-pair at every joint, roots far out, special designs, 5-joint chains through
 the virtual joint, unreachable poses, the fallback."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -45,7 +46,9 @@ def among(A: np.ndarray, B: np.ndarray, kind: np.ndarray, tol: float = 1e-6) -> 
 
 def _dh(theta, a, alpha, c, phi, d=0.0):
     ct, st, ca, sa = np.cos(theta + phi), np.sin(theta + phi), np.cos(alpha), np.sin(alpha)
-    return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, c + d], [0, 0, 0, 1]])
+    return np.array(
+        [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, c + d], [0, 0, 0, 1]]
+    )
 
 
 @pytest.mark.parametrize("k", [1, 2, 3])
@@ -55,22 +58,24 @@ def test_generated_equations_hold_at_random_poses(k):
     rng = np.random.default_rng(k)
     (m1, m2), _, (r1, r2) = ik1a5r._split(k)
     for _ in range(4):
-        dh = np.column_stack([rng.uniform(-1, 1, 6), rng.uniform(-3, 3, 6), rng.uniform(-1, 1, 6), rng.uniform(-3, 3, 6)])
+        dh = np.column_stack(
+            [rng.uniform(-1, 1, 6), rng.uniform(-3, 3, 6), rng.uniform(-1, 1, 6), rng.uniform(-3, 3, 6)]
+        )
         h = rng.uniform(0.05, 0.5)
         theta = rng.uniform(-2 * PI, 2 * PI, 6)
         T = np.eye(4)
         for i in range(6):
             T = T @ _dh(theta[i], *dh[i], d=h * np.cos(theta[i] / 2) if i == k - 1 else 0.0)
         P, Q = kernels.call(f"ik1a5r_equations_{k}", dh, np.array([h]), T)
-        cs = lambda i: np.array([1, np.cos(theta[i - 1] + dh[i - 1, 3]), np.sin(theta[i - 1] + dh[i - 1, 3])])  # noqa: E731
+        cs = lambda i: np.array([1, np.cos(theta[i - 1] + dh[i - 1, 3]), np.sin(theta[i - 1] + dh[i - 1, 3])])
         C, S = np.cos(theta[k - 1] / 2), np.sin(theta[k - 1] / 2)
-        basis = np.array([C ** i * S ** j for i, j in [(i, 0) for i in range(5)] + [(i, 1) for i in range(4)]])
+        basis = np.array([C**i * S**j for i, j in [(i, 0) for i in range(5)] + [(i, 1) for i in range(4)]])
         lhs = P.reshape(14, 81) @ np.kron(basis, np.kron(cs(m1), cs(m2)))
         rhs = Q @ np.kron(cs(r1), cs(r2))
         assert np.abs(lhs - rhs).max() < 1e-12 * (1 + np.abs(lhs).max())
         theta[k - 1] += 0.1  # another A-pair angle: the equations no longer hold
         C, S = np.cos(theta[k - 1] / 2), np.sin(theta[k - 1] / 2)
-        basis = np.array([C ** i * S ** j for i, j in [(i, 0) for i in range(5)] + [(i, 1) for i in range(4)]])
+        basis = np.array([C**i * S**j for i, j in [(i, 0) for i in range(5)] + [(i, 1) for i in range(4)]])
         lhs = P.reshape(14, 81) @ np.kron(basis, np.kron(cs(m1), cs(m2)))
         assert np.abs(lhs - rhs).max() > 1e-6
 
@@ -123,14 +128,40 @@ def test_roots_far_out_stay_unrefined_and_the_real_set_complete():
     they cannot be real, so the real set is still certified, and it is the homotopy's."""
     pairs = [apair.APair.revolute()] * 5 + [apair.APair(0.0745031826908456, 0.06983469217548101)]
     chain = apair.AChain(
-        pairs, [0.21810032223000847, 0.422430246890233, 0.45288691088577204, 0.46043579233104837, 0.3478431338842776,
-                0.4088326243453847],
-        [-1.122227522422231, -0.4602242503166587, 0.8607077028463559, -0.13568826154326774, -0.01660264756828611,
-         0.8547098489551814],
-        [-0.11058163814423963, 0.14652618627324432, 0.09607758334738836, -0.16926469181968762, -0.03022128978810409,
-         0.16657087130195475],
-        [-0.45893781484543994, -0.9747275141021376, -0.6583074597100336, 0.08601125116470865, -0.7962189780280278,
-         -0.8919669504739778])
+        pairs,
+        [
+            0.21810032223000847,
+            0.422430246890233,
+            0.45288691088577204,
+            0.46043579233104837,
+            0.3478431338842776,
+            0.4088326243453847,
+        ],
+        [
+            -1.122227522422231,
+            -0.4602242503166587,
+            0.8607077028463559,
+            -0.13568826154326774,
+            -0.01660264756828611,
+            0.8547098489551814,
+        ],
+        [
+            -0.11058163814423963,
+            0.14652618627324432,
+            0.09607758334738836,
+            -0.16926469181968762,
+            -0.03022128978810409,
+            0.16657087130195475,
+        ],
+        [
+            -0.45893781484543994,
+            -0.9747275141021376,
+            -0.6583074597100336,
+            0.08601125116470865,
+            -0.7962189780280278,
+            -0.8919669504739778,
+        ],
+    )
     problem = homotopy.Problem.of(chain)
     start = homotopy.start_system(problem)
     rng = np.random.default_rng(3)
@@ -141,7 +172,10 @@ def test_roots_far_out_stay_unrefined_and_the_real_set_complete():
         _, size = homotopy.newton(problem, theta, problem.target(T), 8, 1e-8, 1e-6, 0.25, 30.0)
         far = ~(size <= 1e-6)
         assert far.sum() >= 8 and np.all(np.abs(theta[far, 5].imag) > ik1a5r.NEAR_REAL)
-        real, tracked = homotopy.real_angles(problem, theta), homotopy.real_angles(problem, homotopy.solve(problem, start, T).theta)
+        real, tracked = (
+            homotopy.real_angles(problem, theta),
+            homotopy.real_angles(problem, homotopy.solve(problem, start, T).theta),
+        )
         assert among(real, tracked, problem.kind) == len(tracked) == len(real)
         sol = chain.ik(T, full=True)
         assert sol.method == "elimination" and sol.certified and contains(sol.q, q, periods(chain))
@@ -149,16 +183,31 @@ def test_roots_far_out_stay_unrefined_and_the_real_set_complete():
 
 # designs users build, with the A-pair first: (a, α, c)
 SPECIAL = {
-    "right angles, no offsets": ([0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [PI / 2, -PI / 2, PI / 2, PI / 2, -PI / 2, PI / 2],
-                                 [0.0] * 6),
-    "axes 2 and 3 parallel": ([0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [0.7, 0.0, -1.1, 0.9, 1.3, -0.4],
-                              [0.1, -0.1, 0.05, 0.2, -0.15, 0.07]),
-    "intersecting axes (a = 0 at joints 1, 4)": ([0.0, 0.4, 0.2, 0.0, 0.15, 0.1], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4],
-                                                 [0.1, -0.1, 0.05, 0.2, -0.15, 0.07]),
-    "PUMA-like": ([0.0, 0.43, 0.02, 0.0, 0.0, 0.0], [PI / 2, 0.0, PI / 2, -PI / 2, PI / 2, 0.0],
-                  [0.0, 0.0, 0.15, 0.43, 0.0, 0.1]),
-    "millimetre scale": ([3e-4, 4e-4, 2e-4, 2.5e-4, 1.5e-4, 1e-4], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4],
-                         [1e-4, -1e-4, 5e-5, 2e-4, -1.5e-4, 7e-5]),
+    "right angles, no offsets": (
+        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1],
+        [PI / 2, -PI / 2, PI / 2, PI / 2, -PI / 2, PI / 2],
+        [0.0] * 6,
+    ),
+    "axes 2 and 3 parallel": (
+        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1],
+        [0.7, 0.0, -1.1, 0.9, 1.3, -0.4],
+        [0.1, -0.1, 0.05, 0.2, -0.15, 0.07],
+    ),
+    "intersecting axes (a = 0 at joints 1, 4)": (
+        [0.0, 0.4, 0.2, 0.0, 0.15, 0.1],
+        [0.7, 0.5, -1.1, 0.9, 1.3, -0.4],
+        [0.1, -0.1, 0.05, 0.2, -0.15, 0.07],
+    ),
+    "PUMA-like": (
+        [0.0, 0.43, 0.02, 0.0, 0.0, 0.0],
+        [PI / 2, 0.0, PI / 2, -PI / 2, PI / 2, 0.0],
+        [0.0, 0.0, 0.15, 0.43, 0.0, 0.1],
+    ),
+    "millimetre scale": (
+        [3e-4, 4e-4, 2e-4, 2.5e-4, 1.5e-4, 1e-4],
+        [0.7, 0.5, -1.1, 0.9, 1.3, -0.4],
+        [1e-4, -1e-4, 5e-5, 2e-4, -1.5e-4, 7e-5],
+    ),
 }
 
 
@@ -171,9 +220,11 @@ def test_special_designs_round_trip(name):
     pairs = [apair.APair(0.08 * scale, 0.07 * scale)] + [apair.APair.revolute()] * 5
     chain = apair.AChain(pairs, a, alpha, c)
     rng = np.random.default_rng(len(name))
-    qs = list(rng.uniform(-PI, PI, (2, 6))) + [np.array([PI, 0.0, PI, 0.3, 0.5, -0.7]),
-                                               np.array([2 * PI, 0.4, 0.0, -1.0, 1.2, PI]),
-                                               np.array([-PI, 0.4, 0.3, PI, 0.8, 0.0])]
+    qs = list(rng.uniform(-PI, PI, (2, 6))) + [
+        np.array([PI, 0.0, PI, 0.3, 0.5, -0.7]),
+        np.array([2 * PI, 0.4, 0.0, -1.0, 1.2, PI]),
+        np.array([-PI, 0.4, 0.3, PI, 0.8, 0.0]),
+    ]
     routes = set()
     for q in qs:
         T = chain.fk(q)

@@ -1,15 +1,16 @@
 """The 6R elimination (apair.ik.elimination6r, derivations/chain_ik6r.py): the derived equations at random 6R
 poses, the same 16 complex solutions as the homotopy on random and special designs, the chain read
 from its end, the fallback where it cannot certify, 5R chains through the virtual joint."""
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import arm_toml
 
 import apair
 from apair.ik import elimination6r as ik6r
 from apair.ik import homotopy
-from conftest import arm_toml
 
 PI = np.pi
 
@@ -19,8 +20,9 @@ def arm(a, alpha, offset, phi=None) -> apair.AChain:
 
 
 def random_arm(rng, n: int = 6) -> apair.AChain:
-    return arm(rng.uniform(0.1, 0.5, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.2, 0.2, n),
-               rng.uniform(-1.0, 1.0, n))
+    return arm(
+        rng.uniform(0.1, 0.5, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.2, 0.2, n), rng.uniform(-1.0, 1.0, n)
+    )
 
 
 def same_sets(A: np.ndarray, B: np.ndarray, tol: float = 1e-6) -> bool:
@@ -114,21 +116,53 @@ def test_reversed_chain_reaches_the_inverse_pose():
 # designs users build: (a, α, c), and whether the elimination must certify generic poses of it
 SPECIAL = {
     "axes 1 and 2 parallel (read from the end)": (
-        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [0.0, 0.5, -1.1, 0.9, 1.3, -0.4], [0.1, -0.1, 0.05, 0.2, -0.15, 0.07], True),
+        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1],
+        [0.0, 0.5, -1.1, 0.9, 1.3, -0.4],
+        [0.1, -0.1, 0.05, 0.2, -0.15, 0.07],
+        True,
+    ),
     "axes 5 and 6 parallel": (
-        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [0.7, 0.5, -1.1, 0.9, 0.0, -0.4], [0.1, -0.1, 0.05, 0.2, -0.15, 0.07], True),
+        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1],
+        [0.7, 0.5, -1.1, 0.9, 0.0, -0.4],
+        [0.1, -0.1, 0.05, 0.2, -0.15, 0.07],
+        True,
+    ),
     "right angles": (
-        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [PI / 2, -PI / 2, PI / 2, PI / 2, -PI / 2, PI / 2], [0.1, -0.1, 0.05, 0.2, -0.15, 0.07], True),
+        [0.3, 0.4, 0.2, 0.25, 0.15, 0.1],
+        [PI / 2, -PI / 2, PI / 2, PI / 2, -PI / 2, PI / 2],
+        [0.1, -0.1, 0.05, 0.2, -0.15, 0.07],
+        True,
+    ),
     "intersecting axes 3, 4 (a3 = 0), no offsets": (
-        [0.3, 0.4, 0.0, 0.25, 0.15, 0.1], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4], [0.0] * 6, True),
+        [0.3, 0.4, 0.0, 0.25, 0.15, 0.1],
+        [0.7, 0.5, -1.1, 0.9, 1.3, -0.4],
+        [0.0] * 6,
+        True,
+    ),
     "millimetre scale": (
-        [3e-4, 4e-4, 2e-4, 2.5e-4, 1.5e-4, 1e-4], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4], [1e-4, -1e-4, 5e-5, 2e-4, -1.5e-4, 7e-5], True),
+        [3e-4, 4e-4, 2e-4, 2.5e-4, 1.5e-4, 1e-4],
+        [0.7, 0.5, -1.1, 0.9, 1.3, -0.4],
+        [1e-4, -1e-4, 5e-5, 2e-4, -1.5e-4, 7e-5],
+        True,
+    ),
     "kilometre scale": (
-        [300.0, 400.0, 200.0, 250.0, 150.0, 100.0], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4], [100.0, -100.0, 50.0, 200.0, -150.0, 70.0], True),
+        [300.0, 400.0, 200.0, 250.0, 150.0, 100.0],
+        [0.7, 0.5, -1.1, 0.9, 1.3, -0.4],
+        [100.0, -100.0, 50.0, 200.0, -150.0, 70.0],
+        True,
+    ),
     "PUMA-like (spherical wrist: 8 solutions)": (
-        [0.0, 0.43, 0.02, 0.0, 0.0, 0.0], [PI / 2, 0.0, PI / 2, -PI / 2, PI / 2, 0.0], [0.0, 0.0, 0.15, 0.43, 0.0, 0.1], False),
+        [0.0, 0.43, 0.02, 0.0, 0.0, 0.0],
+        [PI / 2, 0.0, PI / 2, -PI / 2, PI / 2, 0.0],
+        [0.0, 0.0, 0.15, 0.43, 0.0, 0.1],
+        False,
+    ),
     "UR-like (axes 2, 3, 4 parallel: 8 solutions)": (
-        [0.0, -0.425, -0.392, 0.0, 0.0, 0.0], [PI / 2, 0.0, 0.0, PI / 2, -PI / 2, 0.0], [0.089, 0.0, 0.0, 0.109, 0.094, 0.082], False),
+        [0.0, -0.425, -0.392, 0.0, 0.0, 0.0],
+        [PI / 2, 0.0, 0.0, PI / 2, -PI / 2, 0.0],
+        [0.089, 0.0, 0.0, 0.109, 0.094, 0.082],
+        False,
+    ),
 }
 
 
@@ -143,7 +177,10 @@ def test_special_designs_stay_complete(name):
     start = homotopy.start_system(problem)
     rng = np.random.default_rng(len(name))
     # joints at 0 and π (θ5 off 0 and π: the wrists of the last two designs would be singular)
-    qs = list(rng.uniform(-PI, PI, (4, 6))) + [np.array([0.0, PI, 0.3, PI, 0.5, -0.7]), np.array([PI, 0.4, 0.0, -1.0, 1.2, 0.0])]
+    qs = list(rng.uniform(-PI, PI, (4, 6))) + [
+        np.array([0.0, PI, 0.3, PI, 0.5, -0.7]),
+        np.array([PI, 0.4, 0.0, -1.0, 1.2, 0.0]),
+    ]
     certified = 0
     for q in qs:
         T = chain.fk(q)
@@ -210,8 +247,15 @@ def test_cli_names_the_route(tmp_path, capsys):
     assert "of 16 complex, by elimination; angles in rad" in out
 
 
-@pytest.mark.parametrize("T, message", [(np.eye(3), "expected a 4x4 transform"), (np.full((4, 4), np.nan), "NaN"),
-                                        (np.zeros(8), "exceptional"), (np.diag([1.0, 1, -1, 1]), "proper rotation")])
+@pytest.mark.parametrize(
+    "T, message",
+    [
+        (np.eye(3), "expected a 4x4 transform"),
+        (np.full((4, 4), np.nan), "NaN"),
+        (np.zeros(8), "exceptional"),
+        (np.diag([1.0, 1, -1, 1]), "proper rotation"),
+    ],
+)
 def test_bad_poses_are_refused_by_name(T, message):
     chain = random_arm(np.random.default_rng(2))
     with pytest.raises(ValueError, match=message) as info:

@@ -2,6 +2,7 @@
 solver (AChain.ik_local) and the solution counts (apair.ik.homotopy.counts): round trips on random and
 special designs, no false solutions, agreement with a dense multi-start search and with the
 eliminations of apair.ik, clear refusals."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -9,13 +10,13 @@ import warnings
 
 import numpy as np
 import pytest
+from conftest import arm_toml
 
 import apair
 from apair.cli import main as cli
 from apair.ik import elimination1a5r as ik1a5r
 from apair.ik import homotopy
 from apair.ik.homotopy import counts as ikcounts
-from conftest import arm_toml
 
 
 def chain_of(pattern: str, rng, special: bool = False) -> apair.AChain:
@@ -28,8 +29,9 @@ def chain_of(pattern: str, rng, special: bool = False) -> apair.AChain:
         a = np.array([0.0, 0.43, 0.02, 0.0, 0.0, 0.0])[:n]
         c = np.array([0.0, 0.0, 0.15, 0.43, 0.0, 0.1])[:n]
         return apair.AChain(pairs, a, alpha, c)
-    return apair.AChain(pairs, rng.uniform(0.1, 0.5, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.2, 0.2, n),
-                        rng.uniform(-1.0, 1.0, n))
+    return apair.AChain(
+        pairs, rng.uniform(0.1, 0.5, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-0.2, 0.2, n), rng.uniform(-1.0, 1.0, n)
+    )
 
 
 @pytest.fixture
@@ -92,8 +94,11 @@ def test_special_design_at_0_and_pi():
     chain = chain_of("RRRRRR", rng, special=True)
     start = chain.prepare_ik()
     assert start.count == 8  # a PUMA-type arm: 8 solutions (Pieper's decoupling)
-    qs = [np.array([0.3, -0.5, 0.4, 0.7, -0.6, 0.2]), np.array([0.0, 0.4, np.pi, 0.5, 0.6, 0.0]),
-          np.array([np.pi, 0.2, -0.3, 0.0, 1.2, np.pi])]
+    qs = [
+        np.array([0.3, -0.5, 0.4, 0.7, -0.6, 0.2]),
+        np.array([0.0, 0.4, np.pi, 0.5, 0.6, 0.0]),
+        np.array([np.pi, 0.2, -0.3, 0.0, 1.2, np.pi]),
+    ]
     for q in qs:
         T = chain.fk(q)
         sol = chain.ik(T, full=True)
@@ -230,16 +235,22 @@ def test_ik_local_converges_within_limits_batched():
     assert r3.residual <= 1e-10 and bool(r3.converged)
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"T": np.full((4, 4), np.nan)}, r"T: contains NaN"),
-    ({"T": np.eye(3)}, r"T: expected a 4x4 transform"),
-    ({"q0": np.zeros(5)}, r"q0"),
-    ({"q0": np.full(6, 10.0)}, r"q0: joint 1 lies outside chain.limits"),
-    ({"max_iter": 0}, r"max_iter: expected a positive integer"),
-    ({"tol": -1.0}, r"tol"),
-    ({"T": np.stack([np.eye(4)] * 3 + [np.diag([1.0, 1.0, -1.0, 1.0])])}, r"not a proper rotation"),
-    ({"T": np.stack([np.eye(4), np.eye(4) + np.eye(4, k=-3) * 0.5])}, r"T: last row must be \[0, 0, 0, 1\], got \[0.5"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"T": np.full((4, 4), np.nan)}, r"T: contains NaN"),
+        ({"T": np.eye(3)}, r"T: expected a 4x4 transform"),
+        ({"q0": np.zeros(5)}, r"q0"),
+        ({"q0": np.full(6, 10.0)}, r"q0: joint 1 lies outside chain.limits"),
+        ({"max_iter": 0}, r"max_iter: expected a positive integer"),
+        ({"tol": -1.0}, r"tol"),
+        ({"T": np.stack([np.eye(4)] * 3 + [np.diag([1.0, 1.0, -1.0, 1.0])])}, r"not a proper rotation"),
+        (
+            {"T": np.stack([np.eye(4), np.eye(4) + np.eye(4, k=-3) * 0.5])},
+            r"T: last row must be \[0, 0, 0, 1\], got \[0.5",
+        ),
+    ],
+)
 def test_ik_local_bad_input(kwargs, message):
     chain = chain_of("RRRRRR", np.random.default_rng(0))
     args = {"T": chain.fk(np.zeros(6)), "q0": np.zeros(6)}
@@ -407,10 +418,19 @@ def test_c_api_of_the_solvers_under_sanitizers(tmp_path):
     prog = tmp_path / "solvers.c"
     prog.write_text(C_PROGRAM)
     exe = tmp_path / "solvers"
-    flags = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-O1", f"-I{cdir}", "-fsanitize=address,undefined",
-             "-fno-sanitize-recover=all"]
-    sources = [str(cdir / n) for n in ("apair_ik.c", "apair_registry.c")] + sorted(str(p) for p in cdir.glob("*.c")
-                                                                                 if p.name not in ("apair_ik.c", "apair_registry.c"))
+    flags = [
+        "-std=c99",
+        "-Wall",
+        "-Wextra",
+        "-Werror",
+        "-O1",
+        f"-I{cdir}",
+        "-fsanitize=address,undefined",
+        "-fno-sanitize-recover=all",
+    ]
+    sources = [str(cdir / n) for n in ("apair_ik.c", "apair_registry.c")] + sorted(
+        str(p) for p in cdir.glob("*.c") if p.name not in ("apair_ik.c", "apair_registry.c")
+    )
     build = subprocess.run(["gcc", *flags, str(prog), *sources, "-o", str(exe), "-lm"], capture_output=True, text=True)
     if build.returncode and "sanitize" in build.stderr:
         pytest.skip("the sanitizer runtimes are not installed")
@@ -427,16 +447,49 @@ def test_a_path_that_jumped_is_tracked_again(tracked):
     pairs = [apair.APair(0.0894522450069962, 0.08317438085810323)] + [apair.APair.revolute()] * 5
     chain = apair.AChain(
         pairs,
-        [0.263635203177209, 0.18895241699896512, 0.4816851661181739, 0.10775141501509339, 0.191913467375736,
-         0.14151345832805196],
-        [-0.3218506212560599, 1.05104389114957, -0.5148268530667165, 0.38861836889957235, 0.46808403937365384,
-         1.1772035292198306],
-        [-0.0818416888849614, -0.021256176303189822, -0.024558618496665297, -0.08726532048028118,
-         0.16744413665010577, -0.11806065323127078],
-        [0.6871820774332562, 0.07303753391445089, 0.9248489585971429, -0.2783536752238869, -0.36779126683054164,
-         0.40316882447018854])
-    q = np.array([-0.5749977310747729, 1.0259281067603379, 1.790164090382775, 2.106829768361326,
-                  -3.0893720644103655, 0.8085360585797985])
+        [
+            0.263635203177209,
+            0.18895241699896512,
+            0.4816851661181739,
+            0.10775141501509339,
+            0.191913467375736,
+            0.14151345832805196,
+        ],
+        [
+            -0.3218506212560599,
+            1.05104389114957,
+            -0.5148268530667165,
+            0.38861836889957235,
+            0.46808403937365384,
+            1.1772035292198306,
+        ],
+        [
+            -0.0818416888849614,
+            -0.021256176303189822,
+            -0.024558618496665297,
+            -0.08726532048028118,
+            0.16744413665010577,
+            -0.11806065323127078,
+        ],
+        [
+            0.6871820774332562,
+            0.07303753391445089,
+            0.9248489585971429,
+            -0.2783536752238869,
+            -0.36779126683054164,
+            0.40316882447018854,
+        ],
+    )
+    q = np.array(
+        [
+            -0.5749977310747729,
+            1.0259281067603379,
+            1.790164090382775,
+            2.106829768361326,
+            -3.0893720644103655,
+            0.8085360585797985,
+        ]
+    )
     sol = chain.ik(chain.fk(q), full=True)
     per = np.array([4 * np.pi] + [2 * np.pi] * 5)
     d = np.abs((sol.q - q + per / 2) % per - per / 2)

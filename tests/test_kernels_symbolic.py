@@ -1,13 +1,14 @@
 """Layer 1: every generated kernel (C and NumPy) against its symbolic spec at random points."""
+
 from __future__ import annotations
 
 import zlib
 
 import numpy as np
 import pytest
+from conftest import evaluate_spec
 
 from apair.kernels import call, manifest
-from conftest import evaluate_spec
 
 POINTS = 100
 
@@ -29,14 +30,16 @@ def random_inputs(spec, rng: np.random.Generator, count: int) -> list[np.ndarray
         half = rng.uniform(-np.pi, np.pi, law.shape[:-1])
         law[..., 0], law[..., 1] = np.cos(half), np.sin(half)
     if spec.name.startswith("ik_"):  # the homotopy's kernels at a complex angle θ, |Im θ| <= 1
-        dims = (count,) + spec.inputs[0].shape[:-2 if spec.name.startswith("ik_system") else -1]
+        dims = (count,) + spec.inputs[0].shape[: -2 if spec.name.startswith("ik_system") else -1]
         theta = rng.uniform(-np.pi, np.pi, dims) + 1j * rng.uniform(-1, 1, dims)
         if spec.name.startswith(("ik_law", "ik_residual")):  # they take v = exp(iθ/2)
             v = np.exp(0.5j * theta)
             out[0] = np.stack([v.real, v.imag], -1)
         else:
             h = rng.uniform(0.0, 0.3, theta.shape)
-            vals = np.stack([np.cos(theta / 2), np.sin(theta / 2), h * np.cos(theta / 2), -h / 2 * np.sin(theta / 2)], -1)
+            vals = np.stack(
+                [np.cos(theta / 2), np.sin(theta / 2), h * np.cos(theta / 2), -h / 2 * np.sin(theta / 2)], -1
+            )
             out[0] = np.stack([vals.real, vals.imag], -1)
     if spec.name.startswith("forward_dynamics"):  # physical links: M is positive definite
         links = out[[a.name for a in spec.inputs].index("links")]
@@ -108,8 +111,12 @@ def test_batched_broadcasts_shared_inputs(backend):
     legs, g = np.zeros((3, 3)), np.array([0.0, 0.0, -9.81])
     law[..., :2] = np.stack([np.cos(law[..., 0]), np.sin(law[..., 0])], axis=-1)
     shared = call("forward_dynamics3", law, *chain_args, dh, links, legs, g)[0]
-    repeated = call("forward_dynamics3", law, *chain_args, *(np.broadcast_to(x, (11,) + x.shape).copy()
-                                                            for x in (dh, links, legs, g)))[0]
+    repeated = call(
+        "forward_dynamics3",
+        law,
+        *chain_args,
+        *(np.broadcast_to(x, (11,) + x.shape).copy() for x in (dh, links, legs, g)),
+    )[0]
     np.testing.assert_array_equal(shared, repeated)
 
 

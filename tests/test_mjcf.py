@@ -6,6 +6,7 @@ constraint Jacobian with the loops held exactly (the KKT system, J̇q̇ by centr
 they must equal chain.forward_dynamics. The motion that MuJoCo's integrator produces with its soft
 loops must follow chain.simulate.
 """
+
 import math
 
 import numpy as np
@@ -24,14 +25,22 @@ def mixed_chain():
     """Special design: an R-pair, a sinusoidal pair with heavy legs of finite radius, a general pair
     with a < b (limited range) and massless legs; twists 0, ±90°, zero lengths and offsets."""
     r_b, r_p = 0.05, 0.04
-    general = apair.APair(r_b, r_p, leg_length=math.sqrt(r_b ** 2 + r_p ** 2 / 4 + 0.5 * r_b * r_p))
+    general = apair.APair(r_b, r_p, leg_length=math.sqrt(r_b**2 + r_p**2 / 4 + 0.5 * r_b * r_p))
     assert general.kind == "general" and general.theta_limit is not None
     pairs = [apair.APair.revolute(), apair.APair(0.06, 0.05, leg_mass=0.08, leg_radius=0.004), general]
-    links = [apair.Link(1.5, [0.0, 0.02, 0.1], np.diag([0.02, 0.03, 0.01])),
-             apair.Link(2.0, [-0.1, 0.0, 0.0], [[0.01, 0.001, 0], [0.001, 0.02, 0], [0, 0, 0.02]]),
-             apair.Link(0.7, [0.0, 0.0, 0.05], np.diag([0.004, 0.004, 0.002]))]
-    return apair.AChain(pairs, a=[0.0, 0.3, 0.0], alpha=[np.pi / 2, 0.0, -np.pi / 2], offset=[0.25, 0.0, 0.0],
-                        theta_offset=[0.0, 0.3, 0.0], links=links)
+    links = [
+        apair.Link(1.5, [0.0, 0.02, 0.1], np.diag([0.02, 0.03, 0.01])),
+        apair.Link(2.0, [-0.1, 0.0, 0.0], [[0.01, 0.001, 0], [0.001, 0.02, 0], [0, 0, 0.02]]),
+        apair.Link(0.7, [0.0, 0.0, 0.05], np.diag([0.004, 0.004, 0.002])),
+    ]
+    return apair.AChain(
+        pairs,
+        a=[0.0, 0.3, 0.0],
+        alpha=[np.pi / 2, 0.0, -np.pi / 2],
+        offset=[0.25, 0.0, 0.0],
+        theta_offset=[0.0, 0.3, 0.0],
+        links=links,
+    )
 
 
 CHAINS = {"example": lambda: io.load(EXAMPLE), "mixed": mixed_chain}
@@ -206,8 +215,10 @@ def test_cli_export(tmp_path, capsys):
     d = mujoco.MjData(m)
     mujoco.mj_resetDataKeyframe(m, d, 0)
     chain = io.load(EXAMPLE)
-    assert np.allclose(d.qpos[[m.jnt_qposadr[j] for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]],
-                       np.radians([10, 20, -30, 40]))
+    assert np.allclose(
+        d.qpos[[m.jnt_qposadr[j] for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]],
+        np.radians([10, 20, -30, 40]),
+    )
     assert main(["export", "mjcf", EXAMPLE, str(out)]) == 2  # exists
     assert "exists" in capsys.readouterr().err
     assert main(["export", "mjcf", EXAMPLE, str(tmp_path / "b.xml"), "--q", "1,x,2,3"]) == 2
@@ -237,8 +248,14 @@ def test_revolute_arm_needs_no_loops():
     own qacc is exact: it equals forward_dynamics to rounding, which checks the links' inertials."""
     pairs = [apair.APair.revolute() for _ in range(6)]
     links = [apair.Link(1.0 + 0.1 * i, [0.01 * i, 0.0, 0.05], np.diag([0.01, 0.012, 0.005])) for i in range(6)]
-    chain = apair.AChain(pairs, a=[0, 0.43, 0.02, 0, 0, 0], alpha=[np.pi / 2, 0, -np.pi / 2, np.pi / 2, -np.pi / 2, 0],
-                         offset=[0, 0, 0.15, 0.43, 0, 0.05], theta_offset=[0, 0.2, 0, 0, 0, np.pi], links=links)
+    chain = apair.AChain(
+        pairs,
+        a=[0, 0.43, 0.02, 0, 0, 0],
+        alpha=[np.pi / 2, 0, -np.pi / 2, np.pi / 2, -np.pi / 2, 0],
+        offset=[0, 0, 0.15, 0.43, 0, 0.05],
+        theta_offset=[0, 0.2, 0, 0, 0, np.pi],
+        links=links,
+    )
     m, d = model(chain)
     assert m.neq == 0 and m.nq == 6
     rng = np.random.default_rng(7)

@@ -1,5 +1,6 @@
 """The C binding (apair._native): the fast path, the converting path and the batch forms all give
 the same numbers as single calls and as the NumPy kernels, and bad calls name what is wrong."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -35,8 +36,10 @@ def test_registry_holds_every_kernel_of_the_manifest():
     assert native.content_hash == kernels.manifest()["content_hash"]
 
 
-@pytest.mark.parametrize("name", ["fk6", "jacobian4", "mass_matrix3", "inverse_dynamics6", "coriolis2", "pair_legs",
-                                  "forward_dynamics4", "energy2"])
+@pytest.mark.parametrize(
+    "name",
+    ["fk6", "jacobian4", "mass_matrix3", "inverse_dynamics6", "coriolis2", "pair_legs", "forward_dynamics4", "energy2"],
+)
 def test_batch_with_shared_or_per_item_design_equals_single_calls(name):
     """Shared design inputs (stride 0) take the hoisted path; per-item ones the plain one."""
     rng = np.random.default_rng(1)

@@ -1,6 +1,7 @@
 """The inverse-kinematics entry points of the C binding (apair._native.ik_*), all marshalled by one
 table: each returns its outputs with the shapes and types its callers unpack, converts what it is
 given as PyArg_ParseTuple would, and names the argument that has the wrong shape."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -32,27 +33,85 @@ def calls(rng, k=3):
     f, g = rng.standard_normal((5, 5)), rng.standard_normal((5, 5))
     n = 3
     return {
-        "ik_track": ((kind, pair, dh, crandn(rng, 7), crandn(rng, 7), 0.8 + 0.6j, crandn(rng, k, 6)),
-                     [(C128, (k, 6)), (I32, (k,)), (I32, (k,)), (F64, (k,))]),
-        "ik_track_slice": ((kind, pair, dh, crandn(rng, 7), crandn(rng, 7), crandn(rng, 2, 6), crandn(rng, 2, 6),
-                            0.2j, 0.5, True, 0.8 + 0.6j, crandn(rng, k, 7)),
-                           [(C128, (k, 7)), (I32, (k,)), (I32, (k,)), (F64, (k,))]),
-        "ik6r_angles": ((crandn(rng, k), crandn(rng, k, 24), rng.standard_normal((14, 27)),
-                         rng.standard_normal((14, 8)), np.ones(3), dh, np.eye(4)), (C128, (k, 6))),
-        "ik_newton": ((kind, pair, dh, crandn(rng, 7), crandn(rng, k, 6), 5, 1e-12, 1e-9, 0.5, 50.0),
-                      [(C128, (k, 6)), (F64, (k,))]),
-        "ik_local": ((np.zeros(n, np.int32), np.zeros((n, 2)), rng.uniform(-1, 1, (n, 4)), np.full(n, -np.pi),
-                      np.full(n, np.pi), 1.0, np.eye(4)[None], rng.uniform(-1, 1, (k, n)), 1e-10, 20),
-                     [(F64, (k, n)), (F64, (k,)), (I32, (k,))]),
-        "ik4_pencil": ((C, Q8, np.zeros(2, np.int32), Q8.T, np.zeros(2, np.int32), 1e300, 0, 1e-8),
-                       [(F64, (5, 5)), (F64, (5, 5)), (F64, (32, 32))]),
-        "ik4_screen": ((np.linspace(-1, 1, k), C, f, g, rng.standard_normal((2, 8, 8)), np.ones(8),
-                        np.array([1e-6, 1e-8, 1e-6])),
-                       [(I32, (k,)), (F64, (k,)), (F64, (k, 8)), (F64, (k,)), (F64, (k, 2, 2)), (I32, (k, 2)),
-                        (F64, (k, 2, 8)), (F64, (k, 2))]),
-        "ik4_left": ((rng.standard_normal((k, 8)), rng.standard_normal((3, 8, 8)), rng.standard_normal((3, 8)),
-                      np.array([1.0, 0.1, 0.0, 1.0]), np.array([1e-8, 1e-8, 1e-3, 1e-8])),
-                     [(I32, (k,)), (F64, (k,)), (F64, (k, 2)), (I32, (k, 2))]),
+        "ik_track": (
+            (kind, pair, dh, crandn(rng, 7), crandn(rng, 7), 0.8 + 0.6j, crandn(rng, k, 6)),
+            [(C128, (k, 6)), (I32, (k,)), (I32, (k,)), (F64, (k,))],
+        ),
+        "ik_track_slice": (
+            (
+                kind,
+                pair,
+                dh,
+                crandn(rng, 7),
+                crandn(rng, 7),
+                crandn(rng, 2, 6),
+                crandn(rng, 2, 6),
+                0.2j,
+                0.5,
+                True,
+                0.8 + 0.6j,
+                crandn(rng, k, 7),
+            ),
+            [(C128, (k, 7)), (I32, (k,)), (I32, (k,)), (F64, (k,))],
+        ),
+        "ik6r_angles": (
+            (
+                crandn(rng, k),
+                crandn(rng, k, 24),
+                rng.standard_normal((14, 27)),
+                rng.standard_normal((14, 8)),
+                np.ones(3),
+                dh,
+                np.eye(4),
+            ),
+            (C128, (k, 6)),
+        ),
+        "ik_newton": (
+            (kind, pair, dh, crandn(rng, 7), crandn(rng, k, 6), 5, 1e-12, 1e-9, 0.5, 50.0),
+            [(C128, (k, 6)), (F64, (k,))],
+        ),
+        "ik_local": (
+            (
+                np.zeros(n, np.int32),
+                np.zeros((n, 2)),
+                rng.uniform(-1, 1, (n, 4)),
+                np.full(n, -np.pi),
+                np.full(n, np.pi),
+                1.0,
+                np.eye(4)[None],
+                rng.uniform(-1, 1, (k, n)),
+                1e-10,
+                20,
+            ),
+            [(F64, (k, n)), (F64, (k,)), (I32, (k,))],
+        ),
+        "ik4_pencil": (
+            (C, Q8, np.zeros(2, np.int32), Q8.T, np.zeros(2, np.int32), 1e300, 0, 1e-8),
+            [(F64, (5, 5)), (F64, (5, 5)), (F64, (32, 32))],
+        ),
+        "ik4_screen": (
+            (np.linspace(-1, 1, k), C, f, g, rng.standard_normal((2, 8, 8)), np.ones(8), np.array([1e-6, 1e-8, 1e-6])),
+            [
+                (I32, (k,)),
+                (F64, (k,)),
+                (F64, (k, 8)),
+                (F64, (k,)),
+                (F64, (k, 2, 2)),
+                (I32, (k, 2)),
+                (F64, (k, 2, 8)),
+                (F64, (k, 2)),
+            ],
+        ),
+        "ik4_left": (
+            (
+                rng.standard_normal((k, 8)),
+                rng.standard_normal((3, 8, 8)),
+                rng.standard_normal((3, 8)),
+                np.array([1.0, 0.1, 0.0, 1.0]),
+                np.array([1e-8, 1e-8, 1e-3, 1e-8]),
+            ),
+            [(I32, (k,)), (F64, (k,)), (F64, (k, 2)), (I32, (k, 2))],
+        ),
     }
 
 
@@ -80,8 +139,7 @@ def test_inputs_are_converted_and_left_alone():
     assert np.array_equal(args[4], theta)
     ro = theta.copy()
     ro.flags.writeable = False
-    other = (args[0].tolist(), np.asfortranarray(args[1]), dh32,
-             args[3].tolist(), ro) + args[5:]
+    other = (args[0].tolist(), np.asfortranarray(args[1]), dh32, args[3].tolist(), ro) + args[5:]
     again = native.ik_newton(*other)
     assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(ref, again))
     local, _ = calls(rng)["ik_local"]
@@ -100,34 +158,41 @@ def test_optional_arguments_of_the_tracker():
         native.ik_track(*args[:6])
 
 
-@pytest.mark.parametrize("name, j, bad, error, message", [
-    ("ik_newton", 4, np.zeros((2, 5), complex), ValueError, r"^theta: dimension 1 is 5, expected 6$"),
-    ("ik_newton", 3, np.zeros((7, 1), complex), ValueError, r"^p: expected 1 dimensions$"),
-    ("ik_newton", 0, np.zeros(6), TypeError, r"Cannot cast"),
-    ("ik_newton", 5, 1.5, TypeError, r"cannot be interpreted as an integer"),
-    ("ik_newton", 5, 2**40, OverflowError, r"^signed integer is greater than maximum$"),
-    ("ik_newton", 6, "x", TypeError, r"^must be real number, not str$"),
-    ("ik_track", 5, "x", TypeError, r"must be real number, not str"),
-    ("ik_track", 0, np.zeros(5, np.int32), ValueError, r"^kind: dimension 0 is 5, expected 6$"),
-    ("ik_local", 1, np.zeros((4, 2)), ValueError, r"^pair: dimension 0 is 4, expected 3$"),
-    ("ik_local", 6, np.tile(np.eye(4), (2, 1, 1)), ValueError, r"^target: one pose, or one per seed$"),
-    ("ik_local", 0, np.full(3, 7, np.int32), ValueError, r"^ik_local: the chain is not valid"),
-    ("ik6r_angles", 1, np.zeros((2, 24), complex), ValueError, r"^vec: dimension 0 is 2, expected 3$"),
-    ("ik4_pencil", 2, np.array([2, 0], np.int32), ValueError, r"^ik4_pencil: the factors leave an image constant"),
-    ("ik4_screen", 5, np.ones(7), ValueError, r"^probe: dimension 0 is 7, expected 8$"),
-    ("ik4_left", 1, np.zeros((1, 8, 8)), ValueError, r"^ik4_left: degrees out of range$"),
-    ("ik4_left", 3, np.zeros(5), ValueError, r"^joint: dimension 0 is 5, expected 4$"),
-])
+@pytest.mark.parametrize(
+    "name, j, bad, error, message",
+    [
+        ("ik_newton", 4, np.zeros((2, 5), complex), ValueError, r"^theta: dimension 1 is 5, expected 6$"),
+        ("ik_newton", 3, np.zeros((7, 1), complex), ValueError, r"^p: expected 1 dimensions$"),
+        ("ik_newton", 0, np.zeros(6), TypeError, r"Cannot cast"),
+        ("ik_newton", 5, 1.5, TypeError, r"cannot be interpreted as an integer"),
+        ("ik_newton", 5, 2**40, OverflowError, r"^signed integer is greater than maximum$"),
+        ("ik_newton", 6, "x", TypeError, r"^must be real number, not str$"),
+        ("ik_track", 5, "x", TypeError, r"must be real number, not str"),
+        ("ik_track", 0, np.zeros(5, np.int32), ValueError, r"^kind: dimension 0 is 5, expected 6$"),
+        ("ik_local", 1, np.zeros((4, 2)), ValueError, r"^pair: dimension 0 is 4, expected 3$"),
+        ("ik_local", 6, np.tile(np.eye(4), (2, 1, 1)), ValueError, r"^target: one pose, or one per seed$"),
+        ("ik_local", 0, np.full(3, 7, np.int32), ValueError, r"^ik_local: the chain is not valid"),
+        ("ik6r_angles", 1, np.zeros((2, 24), complex), ValueError, r"^vec: dimension 0 is 2, expected 3$"),
+        ("ik4_pencil", 2, np.array([2, 0], np.int32), ValueError, r"^ik4_pencil: the factors leave an image constant"),
+        ("ik4_screen", 5, np.ones(7), ValueError, r"^probe: dimension 0 is 7, expected 8$"),
+        ("ik4_left", 1, np.zeros((1, 8, 8)), ValueError, r"^ik4_left: degrees out of range$"),
+        ("ik4_left", 3, np.zeros(5), ValueError, r"^joint: dimension 0 is 5, expected 4$"),
+    ],
+)
 def test_bad_arguments_are_named(name, j, bad, error, message):
     args, _ = calls(np.random.default_rng(3))[name]
     with pytest.raises(error, match=message):
-        getattr(native, name)(*args[:j], bad, *args[j + 1:])
+        getattr(native, name)(*args[:j], bad, *args[j + 1 :])
 
 
 def test_argument_counts_and_keywords_are_refused():
     for name, (args, _) in calls(np.random.default_rng(4)).items():
-        with pytest.raises(TypeError, match=rf"function takes exactly {len(args)} arguments \(0 given\)"
-                           if name != "ik_track" else r"at least 7 arguments \(0 given\)"):
+        with pytest.raises(
+            TypeError,
+            match=rf"function takes exactly {len(args)} arguments \(0 given\)"
+            if name != "ik_track"
+            else r"at least 7 arguments \(0 given\)",
+        ):
             getattr(native, name)()
         with pytest.raises(TypeError, match="takes no keyword arguments"):
             getattr(native, name)(*args, x=1)

@@ -6,6 +6,7 @@ public entry point either returns finite results of the promised shape or raises
 message starts with the name of an argument it was given. Nothing else escapes: no TypeError,
 OverflowError, RuntimeError or IndexError, and no silently wrong answer.
 """
+
 from __future__ import annotations
 
 import re
@@ -17,13 +18,24 @@ from hypothesis import strategies as st
 
 import apair
 
-SETTINGS = settings(max_examples=60, deadline=None, derandomize=True,
-                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+SETTINGS = settings(
+    max_examples=60,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 
 scalars = st.one_of(
-    st.floats(allow_nan=True, allow_infinity=True), st.floats(-1.0, 1.0), st.floats(1e-200, 1e200),
-    st.integers(-10**30, 10**30), st.booleans(), st.complex_numbers(max_magnitude=10), st.none(),
-    st.text(max_size=3), st.just(np.float32(0.5)), st.just(np.int8(3)),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.floats(-1.0, 1.0),
+    st.floats(1e-200, 1e200),
+    st.integers(-(10**30), 10**30),
+    st.booleans(),
+    st.complex_numbers(max_magnitude=10),
+    st.none(),
+    st.text(max_size=3),
+    st.just(np.float32(0.5)),
+    st.just(np.int8(3)),
 )
 
 
@@ -33,8 +45,13 @@ def arrays(draw, shape=None):
     if shape is None:
         shape = tuple(draw(st.lists(st.integers(0, 4), max_size=3)))
     dtype = draw(st.sampled_from(["<f8", ">f8", "<f4", "<i8", ">i4", "|b1", "<c16", "|u1"]))
-    values = draw(st.lists(st.floats(-1e3, 1e3) | st.sampled_from([np.nan, np.inf, 0.0]),
-                           min_size=int(np.prod(shape)), max_size=int(np.prod(shape))))
+    values = draw(
+        st.lists(
+            st.floats(-1e3, 1e3) | st.sampled_from([np.nan, np.inf, 0.0]),
+            min_size=int(np.prod(shape)),
+            max_size=int(np.prod(shape)),
+        )
+    )
     with np.errstate(all="ignore"):
         arr = np.array(values, dtype=float).reshape(shape).astype(dtype)
     if draw(st.booleans()) and arr.ndim >= 1 and arr.shape[-1] > 1:
@@ -85,14 +102,22 @@ def finite(out):
     assert np.isfinite(arr).all()
 
 
-CHAIN = apair.AChain([apair.APair(0.05, 0.04), apair.APair.revolute(), apair.APair(0.05, 0.04, leg_length=0.06)],
-                     [0.3, 0.2, 0.1], [np.pi / 2, 0.0, 0.0],
-                     links=[apair.Link(1.0, [0.1, 0, 0], np.eye(3) * 0.01) for _ in range(3)])
+CHAIN = apair.AChain(
+    [apair.APair(0.05, 0.04), apair.APair.revolute(), apair.APair(0.05, 0.04, leg_length=0.06)],
+    [0.3, 0.2, 0.1],
+    [np.pi / 2, 0.0, 0.0],
+    links=[apair.Link(1.0, [0.1, 0, 0], np.eye(3) * 0.01) for _ in range(3)],
+)
 
 
 @SETTINGS
-@given(r_b=values(()), r_p=values(()), leg_length=st.one_of(st.none(), values(())),
-       leg_radius=values(()), thickness=values(()))
+@given(
+    r_b=values(()),
+    r_p=values(()),
+    leg_length=st.one_of(st.none(), values(())),
+    leg_radius=values(()),
+    thickness=values(()),
+)
 def test_apair_constructor(r_b, r_p, leg_length, leg_radius, thickness):
     def make():
         p = apair.APair(r_b, r_p, leg_length=leg_length, leg_radius=leg_radius, thickness=thickness)
@@ -100,33 +125,47 @@ def test_apair_constructor(r_b, r_p, leg_length, leg_radius, thickness):
         assert np.isfinite(p.translation(0.0))
         return p
 
-    check(make, ["base_radius", "platform_radius", "leg_length", "leg_radius", "thickness"],
-          must_fail=any(bad(v) for v in (r_b, r_p, leg_radius, thickness)) or (leg_length is not None and bad(leg_length)))
+    check(
+        make,
+        ["base_radius", "platform_radius", "leg_length", "leg_radius", "thickness"],
+        must_fail=any(bad(v) for v in (r_b, r_p, leg_radius, thickness))
+        or (leg_length is not None and bad(leg_length)),
+    )
 
 
 @SETTINGS
 @given(a=values((3,)), alpha=values((3,)), offset=values((3,)), gravity=values((3,)))
 def test_achain_constructor(a, alpha, offset, gravity):
     pairs = [apair.APair.revolute()] * 3
-    check(lambda: apair.AChain(pairs, a, alpha, offset=offset, gravity=gravity).fk(np.zeros(3)),
-          ["a", "alpha", "offset", "gravity"], finite, must_fail=any(bad(v) for v in (a, alpha, offset, gravity)))
+    check(
+        lambda: apair.AChain(pairs, a, alpha, offset=offset, gravity=gravity).fk(np.zeros(3)),
+        ["a", "alpha", "offset", "gravity"],
+        finite,
+        must_fail=any(bad(v) for v in (a, alpha, offset, gravity)),
+    )
 
 
 @SETTINGS
 @given(mass=values(()), com=values((3,)), inertia=values((3, 3)))
 def test_link_constructor(mass, com, inertia):
-    check(lambda: apair.Link(mass, com, inertia).as_row(), ["mass", "com", "inertia"], finite,
-          must_fail=any(bad(v) for v in (mass, com, inertia)))
+    check(
+        lambda: apair.Link(mass, com, inertia).as_row(),
+        ["mass", "com", "inertia"],
+        finite,
+        must_fail=any(bad(v) for v in (mass, com, inertia)),
+    )
 
 
 @SETTINGS
 @given(q=values())
-@pytest.mark.parametrize("method, shape", [("fk", (4, 4)), ("fk_study", (8,)), ("jacobian", (6, 3)),
-                                           ("mass_matrix", (3, 3)), ("gravity_torques", (3,))])
+@pytest.mark.parametrize(
+    "method, shape",
+    [("fk", (4, 4)), ("fk_study", (8,)), ("jacobian", (6, 3)), ("mass_matrix", (3, 3)), ("gravity_torques", (3,))],
+)
 def test_chain_methods_of_q(method, shape, q):
     def result(out):
         finite(out)
-        assert out.shape[out.ndim - len(shape):] == shape
+        assert out.shape[out.ndim - len(shape) :] == shape
 
     check(lambda: getattr(CHAIN, method)(q), ["q", "q[..., 2]"], result, must_fail=bad(q))
 
@@ -134,8 +173,12 @@ def test_chain_methods_of_q(method, shape, q):
 @SETTINGS
 @given(q=values((3,)), qd=values(), tau=values())
 def test_forward_dynamics(q, qd, tau):
-    check(lambda: CHAIN.forward_dynamics(q, qd, tau), ["q", "qd", "tau", "q[..., 2]", "links"], finite,
-          must_fail=any(bad(v) for v in (q, qd, tau)))
+    check(
+        lambda: CHAIN.forward_dynamics(q, qd, tau),
+        ["q", "qd", "tau", "q[..., 2]", "links"],
+        finite,
+        must_fail=any(bad(v) for v in (q, qd, tau)),
+    )
 
 
 @SETTINGS
@@ -165,9 +208,29 @@ def test_load_path(path):
 
 
 @SETTINGS
-@given(data=st.dictionaries(st.sampled_from(["pair", "a", "alpha", "alpha_deg", "base_radius", "platform_radius",
-                                             "leg_length", "limits", "limits_deg", "mass", "com", "inertia", "x"]),
-                            values(), max_size=8))
+@given(
+    data=st.dictionaries(
+        st.sampled_from(
+            [
+                "pair",
+                "a",
+                "alpha",
+                "alpha_deg",
+                "base_radius",
+                "platform_radius",
+                "leg_length",
+                "limits",
+                "limits_deg",
+                "mass",
+                "com",
+                "inertia",
+                "x",
+            ]
+        ),
+        values(),
+        max_size=8,
+    )
+)
 def test_chain_file_tables(data):
     from apair.io import chain_from_dict
 

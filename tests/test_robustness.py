@@ -4,6 +4,7 @@ General pairs with a < b at their range end, byte order and alignment at the bin
 hash over every compiled source, the first-use race of the kernel index, joint limits in
 simulation, non-physical and extreme-scale designs, explicit limits checked when a chain is built.
 """
+
 from __future__ import annotations
 
 import math
@@ -97,8 +98,9 @@ def test_complex_kernel_inputs_are_refused_not_cast():
 def test_content_hash_covers_every_compiled_source():
     """A change to any generated C source (so to its template) changes APAIR_CONTENT_HASH, and the
     sources hash the binding was built with is the manifest's."""
-    from codegen.emitter import sources_hash
     from pathlib import Path
+
+    from codegen.emitter import sources_hash
 
     files = {p.name: p.read_text() for p in sorted(Path("generated/c").glob("*.[ch]"))}
     manifest = kernels.manifest()
@@ -160,7 +162,7 @@ def test_first_use_of_the_kernel_index_from_many_threads():
             barrier.wait()
             try:
                 kernels._c_index(native, "fk6")
-            except Exception as exc:  # noqa: BLE001 (the failure being tested)
+            except Exception as exc:
                 errors.append(exc)
 
         threads = [threading.Thread(target=work) for _ in range(8)]
@@ -193,8 +195,9 @@ def test_free_motion_stops_at_the_first_joint_limit():
 
 def test_general_pair_run_ends_at_its_range_end_with_a_partial_trajectory():
     g = apair.APair(0.05, 0.04, leg_length=0.06)
-    chain = apair.AChain([g], [0.1], [0.0], links=[apair.Link(1.0, [0.05, 0, 0], np.eye(3) * 1e-3)],
-                         gravity=(0, -9.81, 0))
+    chain = apair.AChain(
+        [g], [0.1], [0.0], links=[apair.Link(1.0, [0.05, 0, 0], np.eye(3) * 1e-3)], gravity=(0, -9.81, 0)
+    )
     for limits in ("stop", "ignore"):
         traj = chain.simulate([0.5], [0.0], np.linspace(0, 2, 201), limits=limits)
         assert traj.stop is not None and traj.stop.joint == 1
@@ -211,13 +214,16 @@ def test_simulate_refuses_a_start_outside_the_limits():
 
 
 # ----------------------------------------------------------------------------- item 7
-@pytest.mark.parametrize("kwargs, name", [
-    (dict(base_radius=0.05, platform_radius=0.05, leg_length=1e200), "leg_length"),
-    (dict(base_radius=1e200, platform_radius=1e200), "base_radius"),
-    (dict(base_radius=0.05, platform_radius=1e-200), "platform_radius"),
-    (dict(base_radius=0.05, platform_radius=0.05, leg_radius=1e300), "leg_radius"),
-    (dict(base_radius=0.05, platform_radius=0.05, thickness=1e-300), "thickness"),
-])
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        (dict(base_radius=0.05, platform_radius=0.05, leg_length=1e200), "leg_length"),
+        (dict(base_radius=1e200, platform_radius=1e200), "base_radius"),
+        (dict(base_radius=0.05, platform_radius=1e-200), "platform_radius"),
+        (dict(base_radius=0.05, platform_radius=0.05, leg_radius=1e300), "leg_radius"),
+        (dict(base_radius=0.05, platform_radius=0.05, thickness=1e-300), "thickness"),
+    ],
+)
 def test_no_finite_answer_is_refused(kwargs, name):
     with pytest.raises(ValueError, match=f"^{name}: .* outside the range"):
         apair.APair(**kwargs)
@@ -257,7 +263,9 @@ def test_explicit_limits_beyond_the_collision_range_fail_when_built(tmp_path):
     with pytest.raises(ValueError, match=r"limits\[0\]: .* beyond joint 1's collision-free range"):
         apair.AChain([p], [0.1], [0.0], limits=[(-3.0, 1.0)])
     f = tmp_path / "c.toml"
-    f.write_text('[[joint]]\npair = "sinusoidal"\nbase_radius = 0.05\nplatform_radius = 0.04\na = 0.1\n'
-                 'alpha = 0\nlimits_deg = [-170, 90]\n')
+    f.write_text(
+        '[[joint]]\npair = "sinusoidal"\nbase_radius = 0.05\nplatform_radius = 0.04\na = 0.1\n'
+        "alpha = 0\nlimits_deg = [-170, 90]\n"
+    )
     with pytest.raises(ValueError, match=r"joint 1\.limits_deg: \(-170, 90\) deg goes beyond .* \(-120, 120\) deg"):
         apair.load(f)

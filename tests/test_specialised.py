@@ -1,6 +1,7 @@
 """Code for a user's own chain (`apair codegen`, apair.specialise): the generated C builds strictly
 (C99 and C++, -Werror, under ASan/UBSan), its self-test passes, and C, NumPy and the specialised
 chain agree with the generic kernels on random states of random and special chains."""
+
 from __future__ import annotations
 
 import importlib.util
@@ -17,7 +18,7 @@ import apair
 from apair import specialise
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_dynamics import random_chain, random_link, special_chain  # noqa: E402
+from test_dynamics import random_chain, random_link, special_chain
 
 ROOT = Path(__file__).resolve().parent.parent
 STRICT = ["-Wall", "-Wextra", "-Werror", "-pedantic"]
@@ -33,8 +34,14 @@ def ranged_chain(rng) -> apair.AChain:
         b = r_b * r_p
         pairs.append(apair.APair(r_b, r_p, leg_length=np.sqrt(0.5 * b + r_b**2 + r_p**2 / 4), leg_mass=0.05))
     pairs.append(apair.APair.revolute())
-    return apair.AChain(pairs, [0.0, 0.2, 0.1], [np.pi / 2, 0.0, -np.pi / 2], [0.1, 0.0, 0.0], [0.0, np.pi / 2, 0.0],
-                        links=[random_link(rng) for _ in range(3)])
+    return apair.AChain(
+        pairs,
+        [0.0, 0.2, 0.1],
+        [np.pi / 2, 0.0, -np.pi / 2],
+        [0.1, 0.0, 0.0],
+        [0.0, np.pi / 2, 0.0],
+        links=[random_link(rng) for _ in range(3)],
+    )
 
 
 def chains():
@@ -81,9 +88,18 @@ def states(chain, count, rng):
 def generic(chain, kernel, q, qd, qdd, tau):
     args = {"q": q, "qd": qd, "qdd": qdd, "tau": tau}
     method = {"coriolis": "coriolis_matrix"}.get(kernel, kernel)
-    names = {"fk": "q", "fk_study": "q", "jacobian": "q", "mass_matrix": "q", "gravity_torques": "q",
-             "coriolis": "q qd", "bias": "q qd", "energy": "q qd", "inverse_dynamics": "q qd qdd",
-             "forward_dynamics": "q qd tau"}[kernel].split()
+    names = {
+        "fk": "q",
+        "fk_study": "q",
+        "jacobian": "q",
+        "mass_matrix": "q",
+        "gravity_torques": "q",
+        "coriolis": "q qd",
+        "bias": "q qd",
+        "energy": "q qd",
+        "inverse_dynamics": "q qd qdd",
+        "forward_dynamics": "q qd tau",
+    }[kernel].split()
     return getattr(chain, method)(*(args[n] for n in names)), [args[n] for n in names]
 
 
@@ -95,14 +111,26 @@ def close(got, want):
 @gcc
 @pytest.mark.parametrize("lang", ["c99", "c++17"])
 def test_generated_c_builds_strictly_and_passes_its_selftest(generated, lang):
-    for name, (chain, folder) in generated.items():
+    for name, (_chain, folder) in generated.items():
         exe = folder / f"selftest_{lang}"
         x = ["-x", "c++"] if lang.startswith("c++") else []
         cc = "g++" if x else "gcc"
         if shutil.which(cc) is None:
             pytest.skip(f"{cc} is not installed")
-        run([cc, *x, f"-std={lang}", *STRICT, "-O2", str(folder / f"{name}_selftest.c"), str(folder / f"{name}.c"),
-             "-o", str(exe), "-lm"])
+        run(
+            [
+                cc,
+                *x,
+                f"-std={lang}",
+                *STRICT,
+                "-O2",
+                str(folder / f"{name}_selftest.c"),
+                str(folder / f"{name}.c"),
+                "-o",
+                str(exe),
+                "-lm",
+            ]
+        )
         assert "checks passed" in run([str(exe)]).stdout
 
 
@@ -115,9 +143,23 @@ def test_generated_c_is_clean_under_sanitizers(generated, tmp_path):
     for name in ("mixed3", "ranged3"):
         chain, folder = generated[name]
         exe = tmp_path / name
-        run(["gcc", "-std=c99", *STRICT, "-O1", *SANITIZE, str(folder / f"{name}_selftest.c"), str(folder / f"{name}.c"),
-             "-o", str(exe), "-lm"])
-        res = run([str(exe)], env={"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=1", "UBSAN_OPTIONS": "halt_on_error=1"})
+        run(
+            [
+                "gcc",
+                "-std=c99",
+                *STRICT,
+                "-O1",
+                *SANITIZE,
+                str(folder / f"{name}_selftest.c"),
+                str(folder / f"{name}.c"),
+                "-o",
+                str(exe),
+                "-lm",
+            ]
+        )
+        res = run(
+            [str(exe)], env={"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=1", "UBSAN_OPTIONS": "halt_on_error=1"}
+        )
         assert res.stderr == ""
 
 
@@ -156,8 +198,15 @@ def test_special_constants_fold_exactly():
     same chain with a twist one degree off; an R-chain has no law terms (no d)."""
     rng = np.random.default_rng(5)
     base = special_chain(rng, 3)
-    off = apair.AChain(base.pairs, base.a, base.alpha + np.radians(1.0), base.offset, base.theta_offset,
-                       links=base.links, gravity=base.gravity)
+    off = apair.AChain(
+        base.pairs,
+        base.a,
+        base.alpha + np.radians(1.0),
+        base.offset,
+        base.theta_offset,
+        links=base.links,
+        gravity=base.gravity,
+    )
     ops = lambda ch: {k.name: k.ops for k in specialise.lowered(ch, ("fk", "mass_matrix"))[0]}
     assert all(a < b for a, b in zip(ops(base).values(), ops(off).values()))
 
@@ -166,10 +215,18 @@ def test_cli_codegen_writes_refuses_and_explains(tmp_path, capsys):
     from apair.cli import main
 
     out = tmp_path / "arm"
-    assert main(["codegen", str(ROOT / "examples" / "4a_chain.toml"), "--out", str(out), "--kernels", "fk,jacobian"]) == 0
-    assert {p.name for p in out.iterdir()} == {"chain_4a_chain.h", "chain_4a_chain.c", "chain_4a_chain.py",
-                                               "chain_4a_chain_selftest.c", "chain_4a_chain.pc.in",
-                                               "CMakeLists.txt", "manifest.json"}
+    assert (
+        main(["codegen", str(ROOT / "examples" / "4a_chain.toml"), "--out", str(out), "--kernels", "fk,jacobian"]) == 0
+    )
+    assert {p.name for p in out.iterdir()} == {
+        "chain_4a_chain.h",
+        "chain_4a_chain.c",
+        "chain_4a_chain.py",
+        "chain_4a_chain_selftest.c",
+        "chain_4a_chain.pc.in",
+        "CMakeLists.txt",
+        "manifest.json",
+    }
     # again into the same folder: allowed (it wrote it); into a folder of someone else's: refused
     assert main(["codegen", str(ROOT / "examples" / "4a_chain.toml"), "--out", str(out), "--kernels", "fk"]) == 0
     mine = tmp_path / "mine"
@@ -178,8 +235,11 @@ def test_cli_codegen_writes_refuses_and_explains(tmp_path, capsys):
     capsys.readouterr()
     assert main(["codegen", str(ROOT / "examples" / "4a_chain.toml"), "--out", str(mine)]) == 2
     assert "not empty" in capsys.readouterr().err and (mine / "notes.txt").read_text() == "keep"
-    for bad, what in ((["--prefix", "1arm"], "prefix"), (["--prefix", "int"], "prefix"),
-                      (["--kernels", "fk,warp"], "kernels")):
+    for bad, what in (
+        (["--prefix", "1arm"], "prefix"),
+        (["--prefix", "int"], "prefix"),
+        (["--kernels", "fk,warp"], "kernels"),
+    ):
         assert main(["codegen", str(ROOT / "examples" / "4a_chain.toml"), "--out", str(tmp_path / "x"), *bad]) == 2
         assert f"error: {what}" in capsys.readouterr().err
 
@@ -193,13 +253,28 @@ def cache() -> Path:
     return Path(os.environ["APAIR_CACHE"])
 
 
-METHODS = ["fk", "fk_study", "jacobian", "mass_matrix", "coriolis_matrix", "gravity_torques", "bias",
-           "inverse_dynamics", "forward_dynamics", "energy"]
+METHODS = [
+    "fk",
+    "fk_study",
+    "jacobian",
+    "mass_matrix",
+    "coriolis_matrix",
+    "gravity_torques",
+    "bias",
+    "inverse_dynamics",
+    "forward_dynamics",
+    "energy",
+]
 
 
 def method_args(method, q, qd, qdd, tau):
-    return {"coriolis_matrix": (q, qd), "bias": (q, qd), "energy": (q, qd), "inverse_dynamics": (q, qd, qdd),
-            "forward_dynamics": (q, qd, tau)}.get(method, (q,))
+    return {
+        "coriolis_matrix": (q, qd),
+        "bias": (q, qd),
+        "energy": (q, qd),
+        "inverse_dynamics": (q, qd, qdd),
+        "forward_dynamics": (q, qd, tau),
+    }.get(method, (q,))
 
 
 @gcc
@@ -207,7 +282,7 @@ def test_specialised_chain_equals_the_generic_one(cache):
     """Single calls, batches, lists and broadcast inputs of the compiled specialised chains against
     the generic kernels (NumPy backend: independent of both native paths)."""
     rng = np.random.default_rng(11)
-    for name, chain in chains().items():
+    for _name, chain in chains().items():
         fast = chain.specialise()
         assert fast.specialised and isinstance(fast, apair.AChain) and fast.n == chain.n
         q, qd, qdd, tau = states(chain, 40, rng)
@@ -237,8 +312,15 @@ def test_specialised_builds_are_cached_by_content(cache):
     again = chain.specialise()
     assert sorted(p.name for p in (cache / "specialised").iterdir()) == builds  # found again, not rebuilt
     assert again.content_hash == first.content_hash
-    other = apair.AChain(chain.pairs, chain.a + 0.01, chain.alpha, chain.offset, chain.theta_offset,
-                         links=chain.links, gravity=chain.gravity).specialise()
+    other = apair.AChain(
+        chain.pairs,
+        chain.a + 0.01,
+        chain.alpha,
+        chain.offset,
+        chain.theta_offset,
+        links=chain.links,
+        gravity=chain.gravity,
+    ).specialise()
     assert other.content_hash != first.content_hash and (cache / "specialised" / other.content_hash).is_dir()
     subset = chain.specialise(kernels=["fk"])
     q = np.array([0.1, 0.2, 0.3])
@@ -325,5 +407,16 @@ def test_committed_example_code_builds_and_passes_its_selftest(tmp_path):
     """examples/codegen/chain4a (regenerated by make, compared by make check) as a user builds it."""
     folder = ROOT / "examples" / "codegen" / "chain4a"
     exe = tmp_path / "selftest"
-    run(["cc", "-std=c99", *STRICT, str(folder / "chain4a_selftest.c"), str(folder / "chain4a.c"), "-o", str(exe), "-lm"])
+    run(
+        [
+            "cc",
+            "-std=c99",
+            *STRICT,
+            str(folder / "chain4a_selftest.c"),
+            str(folder / "chain4a.c"),
+            "-o",
+            str(exe),
+            "-lm",
+        ]
+    )
     assert "checks passed" in run([str(exe)]).stdout

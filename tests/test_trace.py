@@ -2,6 +2,7 @@
 augmented system's derivatives, and verdicts that can fail: a complete start set passes, a set
 short of one solution fails, a witness set short of its farthest point fails; special designs
 (a UR-like arm with 8 solutions) are certified; the verdict is cached and shown by the CLI."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -9,13 +10,13 @@ import dataclasses
 import flint
 import numpy as np
 import pytest
+from conftest import arm_toml
 
 import apair
 from apair.cli import main as cli
 from apair.ik import homotopy
 from apair.ik.homotopy import counts as ikcounts
 from apair.ik.homotopy import trace
-from conftest import arm_toml
 
 PI = np.pi
 
@@ -44,8 +45,16 @@ def test_slice_derivatives(times_lambda):
     """∂H/∂(θ, λ) and ∂H/∂s of the augmented system against complex central differences."""
     rng = np.random.default_rng(5)
     problem = homotopy.Problem.of(ikcounts.design("ARRARR"))
-    sl = trace.Slice(problem, crandn(rng, 7), crandn(rng, 7), crandn(rng, 2, 6), crandn(rng, 2, 6),
-                     complex(crandn(rng, 1)[0]), complex(crandn(rng, 1)[0]), times_lambda)
+    sl = trace.Slice(
+        problem,
+        crandn(rng, 7),
+        crandn(rng, 7),
+        crandn(rng, 2, 6),
+        crandn(rng, 2, 6),
+        complex(crandn(rng, 1)[0]),
+        complex(crandn(rng, 1)[0]),
+        times_lambda,
+    )
     x, s, h = crandn(rng, 1, 7) * 0.5, np.array([0.3 + 0.2j]), 1e-6
     _, J, Hs = sl(x, s)
     for k in range(7):
@@ -116,8 +125,12 @@ def test_missing_start_solutions_are_found():
 def test_special_design_is_certified():
     """A UR-like arm (axes 2, 3, 4 parallel, twists of 0 and ±90°, zero lengths): 8 solutions,
     which two monodromy runs could only agree on; the trace test certifies them."""
-    chain = apair.AChain([apair.APair.revolute()] * 6, [0.0, -0.425, -0.392, 0.0, 0.0, 0.0],
-                         [PI / 2, 0.0, 0.0, PI / 2, -PI / 2, 0.0], [0.089, 0.0, 0.0, 0.109, 0.094, 0.082])
+    chain = apair.AChain(
+        [apair.APair.revolute()] * 6,
+        [0.0, -0.425, -0.392, 0.0, 0.0, 0.0],
+        [PI / 2, 0.0, 0.0, PI / 2, -PI / 2, 0.0],
+        [0.089, 0.0, 0.0, 0.109, 0.094, 0.082],
+    )
     start = chain.prepare_ik(trace=True)
     assert start.count == 8 and start.traced and start.certified and start.trace < 1e-11
     q = np.array([0.0, PI, 0.3, PI, 0.5, -0.7])

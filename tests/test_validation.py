@@ -1,5 +1,6 @@
 """Every ValueError path of the runtime: bad input is rejected with a message naming the argument
 (docs/conventions.md §5), and the matching valid input is accepted."""
+
 from __future__ import annotations
 
 import math
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 
 import apair
-from apair import APair, AChain
+from apair import AChain, APair
 from apair.study import normalise
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
@@ -34,33 +35,36 @@ def sin_pairs(n):
 
 
 # ---------------------------------------------------------------- APair construction
-@pytest.mark.parametrize("kwargs, name", [
-    ({"base_radius": 0.0}, "base_radius"),
-    ({"base_radius": -1.0}, "base_radius"),
-    ({"base_radius": NAN}, "base_radius"),
-    ({"base_radius": INF}, "base_radius"),
-    ({"base_radius": True}, "base_radius"),
-    ({"base_radius": [1.0, 1.0]}, "base_radius"),
-    ({"base_radius": "one"}, "base_radius"),
-    ({"platform_radius": 0.0}, "platform_radius"),
-    ({"platform_radius": -0.5}, "platform_radius"),
-    ({"platform_radius": NAN}, "platform_radius"),
-    ({"platform_radius": -INF}, "platform_radius"),
-    ({"platform_radius": np.bool_(True)}, "platform_radius"),
-    ({"leg_length": 0.0}, "leg_length"),
-    ({"leg_length": -1.2}, "leg_length"),
-    ({"leg_length": NAN}, "leg_length"),
-    ({"leg_length": INF}, "leg_length"),
-    ({"leg_length": True}, "leg_length"),
-    ({"leg_length": 0.1}, "leg_length"),   # admits no real pose (a + b <= 0)
-    ({"leg_length": 0.5}, "leg_length"),   # the boundary a + b = 0 itself
-    ({"leg_mass": -1.0}, "leg_mass"),
-    ({"leg_mass": NAN}, "leg_mass"),
-    ({"leg_mass": False}, "leg_mass"),
-    ({"leg_radius": -0.01}, "leg_radius"),
-    ({"leg_radius": INF}, "leg_radius"),
-    ({"leg_radius": True}, "leg_radius"),
-])
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"base_radius": 0.0}, "base_radius"),
+        ({"base_radius": -1.0}, "base_radius"),
+        ({"base_radius": NAN}, "base_radius"),
+        ({"base_radius": INF}, "base_radius"),
+        ({"base_radius": True}, "base_radius"),
+        ({"base_radius": [1.0, 1.0]}, "base_radius"),
+        ({"base_radius": "one"}, "base_radius"),
+        ({"platform_radius": 0.0}, "platform_radius"),
+        ({"platform_radius": -0.5}, "platform_radius"),
+        ({"platform_radius": NAN}, "platform_radius"),
+        ({"platform_radius": -INF}, "platform_radius"),
+        ({"platform_radius": np.bool_(True)}, "platform_radius"),
+        ({"leg_length": 0.0}, "leg_length"),
+        ({"leg_length": -1.2}, "leg_length"),
+        ({"leg_length": NAN}, "leg_length"),
+        ({"leg_length": INF}, "leg_length"),
+        ({"leg_length": True}, "leg_length"),
+        ({"leg_length": 0.1}, "leg_length"),  # admits no real pose (a + b <= 0)
+        ({"leg_length": 0.5}, "leg_length"),  # the boundary a + b = 0 itself
+        ({"leg_mass": -1.0}, "leg_mass"),
+        ({"leg_mass": NAN}, "leg_mass"),
+        ({"leg_mass": False}, "leg_mass"),
+        ({"leg_radius": -0.01}, "leg_radius"),
+        ({"leg_radius": INF}, "leg_radius"),
+        ({"leg_radius": True}, "leg_radius"),
+    ],
+)
 def test_apair_rejects(kwargs, name):
     args = {"base_radius": 1.0, "platform_radius": 1.0} | kwargs
     with pytest.raises(ValueError, match=rf"^{name}:"):
@@ -130,12 +134,15 @@ def test_chain_number_of_pairs(n):
         AChain(sin_pairs(n), [0.1] * n, [0.0] * n)
 
 
-@pytest.mark.parametrize("pairs, match", [
-    (None, r"^pairs:"),
-    (5, r"^pairs:"),
-    ([APair(0.05, 0.04), "R"], r"^pairs\[1\]: expected an APair"),
-    ([0.05, APair(0.05, 0.04)], r"^pairs\[0\]: expected an APair"),
-])
+@pytest.mark.parametrize(
+    "pairs, match",
+    [
+        (None, r"^pairs:"),
+        (5, r"^pairs:"),
+        ([APair(0.05, 0.04), "R"], r"^pairs\[1\]: expected an APair"),
+        ([0.05, APair(0.05, 0.04)], r"^pairs\[0\]: expected an APair"),
+    ],
+)
 def test_chain_non_apair(pairs, match):
     with pytest.raises(ValueError, match=match):
         AChain(pairs, [0.1, 0.1], [0.0, 0.0])
@@ -159,13 +166,16 @@ def test_chain_valid_sizes(n):
 
 
 # ---------------------------------------------------------------- q of a chain
-@pytest.mark.parametrize("q", [
-    [0.1, 0.2, 0.3],            # (n+1,)
-    [0.1],                      # (n-1,)
-    np.zeros((5, 3)),           # (N, n+1)
-    0.1,                        # scalar for n = 2
-    np.zeros((2, 1)),
-])
+@pytest.mark.parametrize(
+    "q",
+    [
+        [0.1, 0.2, 0.3],  # (n+1,)
+        [0.1],  # (n-1,)
+        np.zeros((5, 3)),  # (N, n+1)
+        0.1,  # scalar for n = 2
+        np.zeros((2, 1)),
+    ],
+)
 @pytest.mark.parametrize("method", ["fk", "fk_study", "jacobian", "law"])
 def test_q_shape(chain2, q, method):
     with pytest.raises(ValueError, match=r"^q: expected shape \(\.\.\., 2\)"):
@@ -215,21 +225,29 @@ def test_jacobian_at_pair_limit():
 
 
 # ---------------------------------------------------------------- bool and complex arrays
-@pytest.mark.parametrize("call, name", [
-    (lambda c: c.fk([True, False]), "q"),
-    (lambda c: AChain(sin_pairs(2), [True, False], [0.0, 0.0]), "a"),
-    (lambda c: APair(0.05, 0.04).translation(True), "theta"),
-    (lambda c: APair(np.array(True), 1.0), "base_radius"),
-], ids=["q", "a", "theta", "base_radius"])
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda c: c.fk([True, False]), "q"),
+        (lambda c: AChain(sin_pairs(2), [True, False], [0.0, 0.0]), "a"),
+        (lambda c: APair(0.05, 0.04).translation(True), "theta"),
+        (lambda c: APair(np.array(True), 1.0), "base_radius"),
+    ],
+    ids=["q", "a", "theta", "base_radius"],
+)
 def test_bool_arrays_rejected(chain2, call, name):
     with pytest.raises(ValueError, match=rf"^{name}:"):
         call(chain2)
 
 
-@pytest.mark.parametrize("call, name", [
-    (lambda c: c.fk(np.array([0.1 + 1j, 0.2])), "q"),
-    (lambda c: APair(np.complex128(1 + 1j), 1.0), "base_radius"),
-], ids=["q", "base_radius"])
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda c: c.fk(np.array([0.1 + 1j, 0.2])), "q"),
+        (lambda c: APair(np.complex128(1 + 1j), 1.0), "base_radius"),
+    ],
+    ids=["q", "base_radius"],
+)
 def test_complex_arrays_rejected(chain2, call, name):
     with pytest.raises(ValueError, match=rf"^{name}:"):
         call(chain2)
@@ -272,12 +290,15 @@ def test_backends_agree(chain2):
             apair.set_backend(None)
 
 
-@pytest.mark.parametrize("call, name", [
-    (lambda: apair.polynomials.load("nope"), "name"),
-    (lambda: apair.polynomials.raw("nope"), "name"),
-    (lambda: apair.polynomials.text("nope"), "name"),
-    (lambda: apair.polynomials.text("apair_motion", "pdf"), "fmt"),
-])
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda: apair.polynomials.load("nope"), "name"),
+        (lambda: apair.polynomials.raw("nope"), "name"),
+        (lambda: apair.polynomials.text("nope"), "name"),
+        (lambda: apair.polynomials.text("apair_motion", "pdf"), "fmt"),
+    ],
+)
 def test_polynomials_rejects(call, name):
     with pytest.raises(ValueError, match=rf"^{name}:"):
         call()
@@ -308,32 +329,47 @@ def joints(*bodies):
 GOOD = joints(SIN + "a = 0.3\nalpha_deg = 90\noffset = 0.1\n", GEN + "a = 0.25\nalpha = 0.0\ntheta_offset_deg = 30\n")
 
 
-@pytest.mark.parametrize("text, match", [
-    ("[[joint]\n", r"is not valid TOML"),
-    ('name = "x"\nfoo = 1\n' + GOOD, r"unknown keys \['foo'\]"),
-    (joints('pair = "helical"\na = 0.1\nalpha = 0\n'), r"joint 1\.pair: .*'helical'"),
-    (joints("a = 0.1\nalpha = 0\n"), r"joint 1\.pair: .*None"),
-    (joints('pair = "revolute"\nbase_radius = 0.05\na = 0.1\nalpha = 0\n'), r"joint 1: keys \['base_radius'\] are not valid for a revolute"),
-    (joints('pair = "sinusoidal"\nbase_radius = 0.05\na = 0.1\nalpha = 0\n'), r"joint 1: missing platform_radius"),
-    (joints('pair = "general"\nbase_radius = 0.05\nplatform_radius = 0.04\na = 0.1\nalpha = 0\n'), r"joint 1: missing leg_length"),
-    (joints(SIN + "leg_length = 0.09\na = 0.1\nalpha = 0\n"), r"joint 1: keys \['leg_length'\]"),
-    (joints(SIN + "a = 0.1\nalpha = 0\nalpha_deg = 0\n"), r"joint 1: give alpha or alpha_deg, not both"),
-    (joints(SIN + "a = 0.1\nalpha = 0\ntheta_offset = 0\ntheta_offset_deg = 0\n"), r"give theta_offset or theta_offset_deg"),
-    (joints(SIN + 'a = "x"\nalpha = 0\n'), r"joint 1\.a: expected a number, got 'x'"),
-    (joints(SIN + "a = true\nalpha = 0\n"), r"joint 1\.a: expected a number"),
-    (joints(SIN + 'a = 0.1\nalpha_deg = "90"\n'), r"joint 1\.alpha_deg: expected a number"),
-    (joints(SIN + "a = 0.1\nalpha = 0\noffset = [1]\n"), r"joint 1\.offset: expected a number"),
-    (joints('pair = "sinusoidal"\nbase_radius = "big"\nplatform_radius = 0.04\na = 0.1\nalpha = 0\n'), r"joint 1\.base_radius: expected a number"),
-    (joints(SIN + "alpha = 0\n"), r"joint 1: missing a$"),
-    (joints(SIN + "a = 0.1\n"), r"joint 1: missing alpha"),
-    (joints(SIN.replace("0.05", "-0.05") + "a = 0.1\nalpha = 0\n"), r"joint 1\.base_radius: must be > 0"),
-    (joints(GEN.replace("0.09", "0.001") + "a = 0.1\nalpha = 0\n"), r"joint 1\.leg_length: .*no real pose"),
-    (joints(SIN + "a = nan\nalpha = 0\n"), r"joint 1\.a: expected a finite number, got nan"),
-    (joints(SIN + "a = 0.1\nalpha = inf\n"), r"joint 1\.alpha: expected a finite number, got inf"),
-    ('name = "empty"\n', r"needs at least one \[\[joint\]\]"),
-    ("joint = []\n", r"needs at least one \[\[joint\]\]"),
-    (joints(*[SIN + "a = 0.1\nalpha = 0\n"] * 7), r"pairs: a chain has 1 to 6 pairs, got 7"),
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("[[joint]\n", r"is not valid TOML"),
+        ('name = "x"\nfoo = 1\n' + GOOD, r"unknown keys \['foo'\]"),
+        (joints('pair = "helical"\na = 0.1\nalpha = 0\n'), r"joint 1\.pair: .*'helical'"),
+        (joints("a = 0.1\nalpha = 0\n"), r"joint 1\.pair: .*None"),
+        (
+            joints('pair = "revolute"\nbase_radius = 0.05\na = 0.1\nalpha = 0\n'),
+            r"joint 1: keys \['base_radius'\] are not valid for a revolute",
+        ),
+        (joints('pair = "sinusoidal"\nbase_radius = 0.05\na = 0.1\nalpha = 0\n'), r"joint 1: missing platform_radius"),
+        (
+            joints('pair = "general"\nbase_radius = 0.05\nplatform_radius = 0.04\na = 0.1\nalpha = 0\n'),
+            r"joint 1: missing leg_length",
+        ),
+        (joints(SIN + "leg_length = 0.09\na = 0.1\nalpha = 0\n"), r"joint 1: keys \['leg_length'\]"),
+        (joints(SIN + "a = 0.1\nalpha = 0\nalpha_deg = 0\n"), r"joint 1: give alpha or alpha_deg, not both"),
+        (
+            joints(SIN + "a = 0.1\nalpha = 0\ntheta_offset = 0\ntheta_offset_deg = 0\n"),
+            r"give theta_offset or theta_offset_deg",
+        ),
+        (joints(SIN + 'a = "x"\nalpha = 0\n'), r"joint 1\.a: expected a number, got 'x'"),
+        (joints(SIN + "a = true\nalpha = 0\n"), r"joint 1\.a: expected a number"),
+        (joints(SIN + 'a = 0.1\nalpha_deg = "90"\n'), r"joint 1\.alpha_deg: expected a number"),
+        (joints(SIN + "a = 0.1\nalpha = 0\noffset = [1]\n"), r"joint 1\.offset: expected a number"),
+        (
+            joints('pair = "sinusoidal"\nbase_radius = "big"\nplatform_radius = 0.04\na = 0.1\nalpha = 0\n'),
+            r"joint 1\.base_radius: expected a number",
+        ),
+        (joints(SIN + "alpha = 0\n"), r"joint 1: missing a$"),
+        (joints(SIN + "a = 0.1\n"), r"joint 1: missing alpha"),
+        (joints(SIN.replace("0.05", "-0.05") + "a = 0.1\nalpha = 0\n"), r"joint 1\.base_radius: must be > 0"),
+        (joints(GEN.replace("0.09", "0.001") + "a = 0.1\nalpha = 0\n"), r"joint 1\.leg_length: .*no real pose"),
+        (joints(SIN + "a = nan\nalpha = 0\n"), r"joint 1\.a: expected a finite number, got nan"),
+        (joints(SIN + "a = 0.1\nalpha = inf\n"), r"joint 1\.alpha: expected a finite number, got inf"),
+        ('name = "empty"\n', r"needs at least one \[\[joint\]\]"),
+        ("joint = []\n", r"needs at least one \[\[joint\]\]"),
+        (joints(*[SIN + "a = 0.1\nalpha = 0\n"] * 7), r"pairs: a chain has 1 to 6 pairs, got 7"),
+    ],
+)
 def test_load_rejects(tmp_path, text, match):
     path = tmp_path / "chain.toml"
     path.write_text(text)

@@ -1,5 +1,6 @@
 """Constraint varieties of 2-joint chains: vanishing, non-vanishing, the Hilbert function and the
 degree, each checked by something independent of the computation."""
+
 from __future__ import annotations
 
 import json
@@ -108,7 +109,9 @@ def test_degree_by_counting_points_on_two_hyperplanes():
 
 
 def test_float_variant_for_a_general_pair():
-    chain = apair.AChain([apair.APair(0.1, 0.05, leg_length=0.12), apair.APair.revolute()], [0.3, 0.25], [np.pi / 2, 0.0])
+    chain = apair.AChain(
+        [apair.APair(0.1, 0.05, leg_length=0.12), apair.APair.revolute()], [0.3, 0.25], [np.pi / 2, 0.0]
+    )
     W = chain.constraint_variety(max_degree=2)
     assert not W.exact and W.residual < 1e-10
     assert W.dims[2] >= 1  # at least the Study quadric
@@ -126,8 +129,10 @@ def test_variety_inputs(tmp_path):
 
 def test_cli_variety(capsys, tmp_path):
     path = tmp_path / "c.toml"
-    path.write_text("[[joint]]\npair = \"revolute\"\na = 0.3\nalpha_deg = 90\noffset = 0.1\n"
-                    "[[joint]]\npair = \"revolute\"\na = 0.25\nalpha = 0\n")
+    path.write_text(
+        '[[joint]]\npair = "revolute"\na = 0.3\nalpha_deg = 90\noffset = 0.1\n'
+        '[[joint]]\npair = "revolute"\na = 0.25\nalpha = 0\n'
+    )
     assert main(["variety", str(path), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["exact"] and data["degree"] == 2 and len(data["equations"]) == 5
@@ -175,8 +180,11 @@ DESIGN = sp.symbols("a c_alpha s_alpha h1 h2", real=True)
 def symbolic_forms(kinds, a, cs, h1, h2, generic_only=False):
     """The derived forms of a chain kind with a design put in; cs = (cos, sin) of α/2 up to a factor."""
     vals = dict(zip(DESIGN, (a, *cs, h1, h2)))
-    return [sp.Poly(sp.expand(e.subs(vals)), *X) for label, e in SYMBOLIC.items()
-            if label.startswith(kinds + "_") and not (generic_only and "special" in NOTES[label])]
+    return [
+        sp.Poly(sp.expand(e.subs(vals)), *X)
+        for label, e in SYMBOLIC.items()
+        if label.startswith(kinds + "_") and not (generic_only and "special" in NOTES[label])
+    ]
 
 
 def pair(kind, radius):

@@ -1,4 +1,5 @@
 """apair view: the page in a real headless browser (Debian's Chromium, driven by Playwright)."""
+
 import math
 import os
 import shutil
@@ -12,17 +13,32 @@ from apair.cli import main
 
 EXAMPLE = "examples/4a_chain.toml"
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update",
-        "--disable-sync", "--no-first-run"]
+ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+]
 
 
 def mixed_chain():
     r_b, r_p = 0.05, 0.04
-    general = apair.APair(r_b, r_p, leg_length=math.sqrt(r_b ** 2 + r_p ** 2 / 4 + 0.5 * r_b * r_p), leg_radius=0.003)
-    pairs = [apair.APair.revolute(), apair.APair(0.06, 0.05, leg_radius=0.004, thickness=0.005), general,
-             apair.APair.revolute()]
-    return apair.AChain(pairs, a=[0.0, 0.3, 0.0, 0.1], alpha=[np.pi / 2, 0.0, -np.pi / 2, 0.0],
-                        offset=[0.25, 0.0, 0.0, 0.05], theta_offset=[0.0, 0.3, 0.0, -1.0])
+    general = apair.APair(r_b, r_p, leg_length=math.sqrt(r_b**2 + r_p**2 / 4 + 0.5 * r_b * r_p), leg_radius=0.003)
+    pairs = [
+        apair.APair.revolute(),
+        apair.APair(0.06, 0.05, leg_radius=0.004, thickness=0.005),
+        general,
+        apair.APair.revolute(),
+    ]
+    return apair.AChain(
+        pairs,
+        a=[0.0, 0.3, 0.0, 0.1],
+        alpha=[np.pi / 2, 0.0, -np.pi / 2, 0.0],
+        offset=[0.25, 0.0, 0.0, 0.05],
+        theta_offset=[0.0, 0.3, 0.0, -1.0],
+    )
 
 
 @pytest.fixture(scope="module")

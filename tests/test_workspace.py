@@ -1,5 +1,6 @@
 """Workspaces: the volume against exact shells, the 2A surface against its variety, Dask runs
 against local ones, pictures and the command line."""
+
 from __future__ import annotations
 
 import math
@@ -96,9 +97,11 @@ def test_pictures(tmp_path):
     assert np.allclose(links[-1][1], chain.fk(q)[:3, 3])  # the drawn chain ends at fk(q)
     assert sum(s[2] == "leg" for s in segs) == 6 * 4
     ws = arm(0.3, 0.2).workspace(samples=8_000, resolution=10)
-    for path, make, magic in ((tmp_path / "w.png", lambda p: ws.plot(p), b"\x89PNG"),
-                              (tmp_path / "c.png", lambda p: chain_picture(chain, q, p), b"\x89PNG"),
-                              (tmp_path / "a.gif", lambda p: pair_animation(chain.pairs[0], p, frames=6), b"GIF8")):
+    for path, make, magic in (
+        (tmp_path / "w.png", lambda p: ws.plot(p), b"\x89PNG"),
+        (tmp_path / "c.png", lambda p: chain_picture(chain, q, p), b"\x89PNG"),
+        (tmp_path / "a.gif", lambda p: pair_animation(chain.pairs[0], p, frames=6), b"GIF8"),
+    ):
         make(path)
         assert path.read_bytes()[:4] == magic
         with pytest.raises(ValueError, match="exists"):
@@ -117,8 +120,10 @@ def test_leg_lengths_in_the_picture_are_the_pairs():
 def test_cli_workspace(tmp_path, capsys):
     out = tmp_path / "w.png"
     f = tmp_path / "arm.toml"
-    f.write_text('[[joint]]\npair = "revolute"\na = 0\nalpha_deg = 90\n[[joint]]\npair = "revolute"\na = 0.3\nalpha = 0\n'
-                 '[[joint]]\npair = "revolute"\na = 0.2\nalpha = 0\n')
+    f.write_text(
+        '[[joint]]\npair = "revolute"\na = 0\nalpha_deg = 90\n[[joint]]\npair = "revolute"\na = 0.3\nalpha = 0\n'
+        '[[joint]]\npair = "revolute"\na = 0.2\nalpha = 0\n'
+    )
     assert main(["workspace", str(f), "--samples", "8000", "--resolution", "10", "--plot", str(out)]) == 0
     cap = capsys.readouterr()
     assert "workspace volume" in cap.out and "batches" in cap.err and out.stat().st_size > 1000
@@ -130,12 +135,15 @@ def test_cli_workspace(tmp_path, capsys):
 REV = apair.APair.revolute()
 
 
-@pytest.mark.parametrize("chain, dimension, exact", [
-    (apair.AChain([REV], [0.3], [0.0]), 1, 2 * np.pi * 0.3),                              # a circle
-    (apair.AChain([REV, REV], [0.3, 0.1], [0.0, 0.0]), 2, np.pi * (0.4**2 - 0.2**2)),        # a planar annulus
-    (apair.AChain([REV, REV], [0.0, 0.3], [np.pi / 2, 0.0]), 2, 4 * np.pi * 0.3**2),          # a sphere
-    (apair.AChain([REV, REV], [0.3, 0.0], [np.pi / 2, 0.0]), 1, 2 * np.pi * 0.3),            # joint 2 moves nothing
-])
+@pytest.mark.parametrize(
+    "chain, dimension, exact",
+    [
+        (apair.AChain([REV], [0.3], [0.0]), 1, 2 * np.pi * 0.3),  # a circle
+        (apair.AChain([REV, REV], [0.3, 0.1], [0.0, 0.0]), 2, np.pi * (0.4**2 - 0.2**2)),  # a planar annulus
+        (apair.AChain([REV, REV], [0.0, 0.3], [np.pi / 2, 0.0]), 2, 4 * np.pi * 0.3**2),  # a sphere
+        (apair.AChain([REV, REV], [0.3, 0.0], [np.pi / 2, 0.0]), 1, 2 * np.pi * 0.3),  # joint 2 moves nothing
+    ],
+)
 def test_curves_and_surfaces_report_dimension_and_measure_not_a_volume(chain, dimension, exact):
     ws = chain.workspace(samples=120_000 if dimension == 2 else 12_000, seed=3)
     assert ws.dimension == dimension and ws.volume is None and ws.volume_error is None

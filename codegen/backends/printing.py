@@ -1,5 +1,6 @@
 """What the backends' expression printers share: small powers as products, floats as their
 shortest exact literal, and (C and JavaScript) π and e as 25-digit decimals."""
+
 from __future__ import annotations
 
 import sympy as sp

@@ -9,6 +9,7 @@
 Lowering is the expensive part of code generation and is independent per kernel, so
 codegen/__main__.py runs it in worker processes; its result (codegen/ir.py) is plain data.
 """
+
 from __future__ import annotations
 
 import sympy as sp
@@ -36,22 +37,26 @@ def lower(spec: KernelSpec) -> Lowered:
         used |= sp.S(e).free_symbols
     outputs, pos = [], 0
     for a in spec.outputs:
-        outputs.append((a, list(reduced[pos:pos + a.size])))
+        outputs.append((a, list(reduced[pos : pos + a.size])))
         pos += a.size
     ops = int(sp.count_ops([e for _, e in assignments] + list(reduced)))
     printed = {target: printing.print_assignments(p, assignments) for target, p in printing.PRINTERS.items()}
     code = {target: printing.code(p, assignments, outputs, printed[target]) for target, p in printing.PRINTERS.items()}
-    signature = Signature(spec.name, spec.doc, spec.source, [bare(a) for a in spec.inputs],
-                          [bare(a) for a in spec.outputs], spec.wide)
+    signature = Signature(
+        spec.name, spec.doc, spec.source, [bare(a) for a in spec.inputs], [bare(a) for a in spec.outputs], spec.wide
+    )
     calls = printing.calls(spec, used)
     hoisted = hoist(spec, local, assignments, reduced, printed["c"])
     if spec.wide and (spec.calls or hoisted is None):
-        raise ValueError(f"{spec.name}: a wide kernel needs a design-only part and calls no other kernel "
-                         "(the C backend emits its wide version from the hoisted core)")
+        raise ValueError(
+            f"{spec.name}: a wide kernel needs a design-only part and calls no other kernel "
+            "(the C backend emits its wide version from the hoisted core)"
+        )
     js = None
     if spec.name in WEB_KERNELS:
         if spec.calls:
             raise ValueError(f"{spec.name}: a web kernel cannot call other kernels")
         js = printing.code(printing.JS, assignments, outputs)
-    return Lowered(signature, slots(spec.inputs, local, used), code["c"], code["py"], ops, spec.fingerprint(),
-                   hoisted, calls, js)
+    return Lowered(
+        signature, slots(spec.inputs, local, used), code["c"], code["py"], ops, spec.fingerprint(), hoisted, calls, js
+    )

@@ -6,6 +6,7 @@ symbols free. Steps that no output needs are dropped first; after CSE, a step th
 symbol or a number is substituted away, what nothing uses any more is dropped, and every
 intermediate is renamed t0, t1, ... in order of definition (short lines, small sources).
 """
+
 from __future__ import annotations
 
 import sympy as sp
@@ -33,7 +34,7 @@ def eliminate(steps: list, outputs: list) -> tuple[list, list]:
     exprs = [e for _, e in steps] + outputs
     replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), order="canonical")
     assignments = ordered(replacements, [(s, e) for (s, _), e in zip(steps, reduced[: len(steps)])])
-    return assignments, reduced[len(steps):]
+    return assignments, reduced[len(steps) :]
 
 
 def drop_aliases(assignments: list, reduced: list) -> tuple[list, list]:

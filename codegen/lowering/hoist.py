@@ -1,5 +1,6 @@
 """Lowering pass 4, hoisting of invariants: the assignments that depend on design inputs alone,
 computed once for a batch that shares its design (the C backend's name_invariants / name_core)."""
+
 from __future__ import annotations
 
 import sympy as sp
@@ -25,7 +26,11 @@ def hoist(spec: KernelSpec, local: dict, assignments: list, reduced: list, print
     if not stored:
         return None
     used_inv = set().union(*(e.free_symbols for _, e in inv))
-    return Hoisted(slots(spec.inputs, local, used_inv), [(str(s), printed[s]) for s, _ in inv],
-                   [str(s) for s in stored], slots(spec.inputs, local, needed),
-                   [(str(s), printed[s]) for s, _ in core],
-                   int(sp.count_ops([e for _, e in core] + [sp.S(e) for e in reduced])))
+    return Hoisted(
+        slots(spec.inputs, local, used_inv),
+        [(str(s), printed[s]) for s, _ in inv],
+        [str(s) for s in stored],
+        slots(spec.inputs, local, needed),
+        [(str(s), printed[s]) for s, _ in core],
+        int(sp.count_ops([e for _, e in core] + [sp.S(e) for e in reduced])),
+    )

@@ -1,4 +1,5 @@
 """Lowering pass 3, ordering: the CSE temporaries placed just before their first use."""
+
 from __future__ import annotations
 
 

@@ -6,6 +6,7 @@ it is built); here the names are made safe for the printed code: a scalar named 
 argument is renamed (theta -> theta_v), and no input or result may look like a CSE temporary
 (t0, t1, ...).
 """
+
 from __future__ import annotations
 
 import sympy as sp

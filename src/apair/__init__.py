@@ -3,6 +3,7 @@
 The closed forms are derived symbolically (derivations/), emitted as C and NumPy kernels
 (codegen/ -> generated/), and loaded here. See docs/conventions.md for frames and conventions.
 """
+
 from . import plots, polynomials  # plots imports matplotlib only when a picture is drawn
 from ._version import __version__
 from .chain import AChain
@@ -12,4 +13,16 @@ from .link import Link
 from .pair import APair
 from .simulate import Trajectory
 
-__all__ = ["APair", "AChain", "Link", "Trajectory", "load", "plots", "polynomials", "set_backend", "backend", "c_available", "__version__"]
+__all__ = [
+    "APair",
+    "AChain",
+    "Link",
+    "Trajectory",
+    "load",
+    "plots",
+    "polynomials",
+    "set_backend",
+    "backend",
+    "c_available",
+    "__version__",
+]

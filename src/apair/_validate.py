@@ -1,4 +1,5 @@
 """Input checks shared by the runtime: every failure is a ValueError that names the argument."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -17,7 +18,7 @@ def real_array(name: str, value, *, trailing: tuple[int, ...] | None = None, ndi
     arr = raw.astype(np.float64, copy=False)
     if trailing is not None:
         k = len(trailing)
-        if arr.ndim < k or arr.shape[arr.ndim - k:] != trailing:
+        if arr.ndim < k or arr.shape[arr.ndim - k :] != trailing:
             want = "(" + ", ".join(["..."] + [str(t) for t in trailing]) + ")"
             raise ValueError(f"{name}: expected shape {want}, got {arr.shape}")
     if arr.ndim > MAX_DIMS:

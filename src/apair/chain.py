@@ -6,6 +6,7 @@ to one generated chain kernel for n joints (derivations/chain_kinematics.py, cha
 in one native call (apair.kernels.native_chain) when the inputs are canonical float64 arrays;
 otherwise the validating path checks and converts them first. Batches stay in the kernels.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -23,8 +24,18 @@ from .study import normalise
 MAX_JOINTS = 6
 # The kernel-backed methods in the order of their native fast path (apair.kernels.native_chain):
 # (kernel family, whether a joint at its range end is refused because d' is unbounded there).
-METHODS = (("fk", False), ("fk_study", False), ("jacobian", True), ("mass_matrix", True), ("coriolis", True),
-           ("gravity", True), ("bias", True), ("inverse_dynamics", True), ("forward_dynamics", True), ("energy", True))
+METHODS = (
+    ("fk", False),
+    ("fk_study", False),
+    ("jacobian", True),
+    ("mass_matrix", True),
+    ("coriolis", True),
+    ("gravity", True),
+    ("bias", True),
+    ("inverse_dynamics", True),
+    ("forward_dynamics", True),
+    ("energy", True),
+)
 
 
 class AChain:
@@ -32,8 +43,9 @@ class AChain:
     theta_offset (φ). Angles in radians, lengths in metres. `limits`: per joint an explicit range
     (lo, hi) or None for the pair's own (see `limits`)."""
 
-    def __init__(self, pairs, a, alpha, offset=None, theta_offset=None, links=None, gravity=(0.0, 0.0, -9.81),
-                 limits=None):
+    def __init__(
+        self, pairs, a, alpha, offset=None, theta_offset=None, links=None, gravity=(0.0, 0.0, -9.81), limits=None
+    ):
         try:
             pairs = list(pairs)
         except TypeError as exc:
@@ -105,8 +117,10 @@ class AChain:
                 raise ValueError(f"limits[{i}]: expected lo < hi, got ({lo}, {hi})")
             plo, phi = self.pairs[i].motion_range()
             if lo < plo or hi > phi:
-                raise ValueError(f"limits[{i}]: ({lo:.6g}, {hi:.6g}) rad goes beyond joint {i + 1}'s collision-free "
-                                 f"range ({plo:.6g}, {phi:.6g}) rad")
+                raise ValueError(
+                    f"limits[{i}]: ({lo:.6g}, {hi:.6g}) rad goes beyond joint {i + 1}'s collision-free "
+                    f"range ({plo:.6g}, {phi:.6g}) rad"
+                )
             out.append((float(lo), float(hi)))
         return out
 
@@ -132,9 +146,11 @@ class AChain:
         return len(self.pairs)
 
     def __repr__(self) -> str:
-        return (f"AChain({self.pairs!r}, a={self.a.tolist()}, alpha={self.alpha.tolist()}, "
-                f"offset={self.offset.tolist()}, theta_offset={self.theta_offset.tolist()}, "
-                f"links={self.links!r}, gravity={self.gravity.tolist()})")
+        return (
+            f"AChain({self.pairs!r}, a={self.a.tolist()}, alpha={self.alpha.tolist()}, "
+            f"offset={self.offset.tolist()}, theta_offset={self.theta_offset.tolist()}, "
+            f"links={self.links!r}, gravity={self.gravity.tolist()})"
+        )
 
     def _q(self, q, name: str = "q") -> np.ndarray:
         q = V.real_array(name, q, trailing=(self.n,))
@@ -148,17 +164,21 @@ class AChain:
         groups = []
         for kernel, idx in sorted(by_kernel.items()):
             values = np.array([self.pairs[i].law_kernel[1] for i in idx])
-            groups.append((kernel, np.array(idx), [np.ascontiguousarray(values[:, [k]])
-                                                   for k in range(values.shape[1])]))
+            groups.append(
+                (kernel, np.array(idx), [np.ascontiguousarray(values[:, [k]]) for k in range(values.shape[1])])
+            )
         return groups
 
     def _native_chain(self):
         """The native fast path of the methods (apair.kernels.native_chain): per method its
         generic chain kernel, fed by the pairs' law kernels."""
         return native_chain(
-            self.n, [(f"{family}{self.n}", strict) for family, strict in METHODS], [p.law_kernel for p in self.pairs],
+            self.n,
+            [(f"{family}{self.n}", strict) for family, strict in METHODS],
+            [p.law_kernel for p in self.pairs],
             [p.theta_limit if p.theta_limit is not None else math.inf for p in self.pairs],
-            {"dh": self._dh, "links": self._links, "legs": self._legs, "gravity": self._gravity})
+            {"dh": self._dh, "links": self._links, "legs": self._legs, "gravity": self._gravity},
+        )
 
     def law(self, q) -> np.ndarray:
         """(..., n, 3): each joint's (d, d', d'') at q."""
@@ -260,8 +280,10 @@ class AChain:
         if out is None:
             out = self._evaluate(8, "forward_dynamics", q, self._body, qd=qd, tau=tau)
             if not np.isfinite(out).all():
-                raise ValueError("links: the mass matrix is not positive definite at this q "
-                                 "(give every moving body mass and inertia)")
+                raise ValueError(
+                    "links: the mass matrix is not positive definite at this q "
+                    "(give every moving body mass and inertia)"
+                )
         return out
 
     def energy(self, q, qd) -> np.ndarray:
@@ -273,7 +295,7 @@ class AChain:
     def _body(self) -> tuple[np.ndarray, ...]:
         return self._dh, self._links, self._legs, self._gravity
 
-    def specialise(self, kernels=None) -> "AChain":
+    def specialise(self, kernels=None) -> AChain:
         """This chain with its design built into its own kernels (`apair codegen`'s C, compiled
         once into the cache, see apair.files.cache_root, and found again by content hash):
         the same methods, faster. `kernels`: a subset of fk, fk_study, jacobian, mass_matrix,
@@ -375,8 +397,10 @@ class AChain:
         from .ik import homotopy
 
         if self.n < 5:
-            raise ValueError(f"chain: start systems are for 5 and 6 joints (this chain has {self.n}; its ik is "
-                             "solved by elimination)")
+            raise ValueError(
+                f"chain: start systems are for 5 and 6 joints (this chain has {self.n}; its ik is "
+                "solved by elimination)"
+            )
         certify = None
         if trace:
             from .ik.homotopy.trace import certify
@@ -391,16 +415,32 @@ class AChain:
 
         return ik_local(self, T, q0, tol=tol, max_iter=max_iter)
 
-    def workspace(self, samples: int = 300_000, resolution: int = 24, rounds: int = 4, poses: bool = False,
-                  engine=None, seed: int = 0, progress=None):
+    def workspace(
+        self,
+        samples: int = 300_000,
+        resolution: int = 24,
+        rounds: int = 4,
+        poses: bool = False,
+        engine=None,
+        seed: int = 0,
+        progress=None,
+    ):
         """The reachable workspace of the end-effector origin inside `limits` (apair.workspace):
         `.points`, `.boundary`, `.volume`, `.volume_error` (one standard uncertainty), `.plot(path)`.
         engine: None (this process), "threads"/"processes" (local Dask) or a dask.distributed
         scheduler address or Client; the result does not depend on it."""
         from .workspace import workspace
 
-        return workspace(self, samples=samples, resolution=resolution, rounds=rounds, poses=poses, engine=engine,
-                         seed=seed, progress=progress)
+        return workspace(
+            self,
+            samples=samples,
+            resolution=resolution,
+            rounds=rounds,
+            poses=poses,
+            engine=engine,
+            seed=seed,
+            progress=progress,
+        )
 
     def within_limits(self, q) -> np.ndarray:
         """(...): whether each joint vector lies inside `limits` (bounds included)."""

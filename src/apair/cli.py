@@ -1,4 +1,5 @@
 """The `apair` command line: inspect derived polynomials, evaluate chains, run the demonstration."""
+
 from __future__ import annotations
 
 import argparse
@@ -38,14 +39,16 @@ def _show_ik_counts(args) -> int:
     if args.json:
         print(json.dumps(rows, indent=1))
         return 0
-    print("Generic number of complex inverse-kinematics solutions of R/A chains (A: sinusoidal A-pair,\n"
-          "R: R-pair; a pattern and its reverse have the same count). n < 6: at a pose of the chain's own\n"
-          "image. Computed by apair.ik.homotopy.counts (make ik-counts) with the homotopy machinery of chain.ik;\n"
-          "'how' lists the start set's monodromy runs (for n < 6 the 6-joint set with virtual joints);\n"
-          "certified: by the trace test where 'how' names one, else two runs found the count and a run\n"
-          "on a second design found no more (weaker).\n"
-          "No design has more solutions than its pattern's count, so chain.ik takes a start set that\n"
-          "reaches it as complete.")
+    print(
+        "Generic number of complex inverse-kinematics solutions of R/A chains (A: sinusoidal A-pair,\n"
+        "R: R-pair; a pattern and its reverse have the same count). n < 6: at a pose of the chain's own\n"
+        "image. Computed by apair.ik.homotopy.counts (make ik-counts) with the homotopy machinery of chain.ik;\n"
+        "'how' lists the start set's monodromy runs (for n < 6 the 6-joint set with virtual joints);\n"
+        "certified: by the trace test where 'how' names one, else two runs found the count and a run\n"
+        "on a second design found no more (weaker).\n"
+        "No design has more solutions than its pattern's count, so chain.ik takes a start set that\n"
+        "reaches it as complete."
+    )
     print(f"{'pattern':8s} {'count':>6s}  {'certified':9s}  how")
     for r in rows:
         print(f"{r['pattern']:8s} {r['count']:6d}  {'yes' if r['certified'] else 'no':9s}  {r['how']}")
@@ -57,20 +60,26 @@ def _cmd_ik_prepare(args) -> int:
 
     chain = load(args.file)
     if chain.n < 5:
-        raise ValueError(f"{args.file}: {chain.n} joints; start systems are for 5 and 6 joints (fewer are solved "
-                         "by elimination, nothing to prepare)")
+        raise ValueError(
+            f"{args.file}: {chain.n} joints; start systems are for 5 and 6 joints (fewer are solved "
+            "by elimination, nothing to prepare)"
+        )
     progress = None
     if not args.quiet:
+
         def progress(loops, count):
             print(f"\rmonodromy: loop {loops:4d}, {count:6d} points", end="", file=sys.stderr, flush=True)
+
     start = chain.prepare_ik(progress=progress, refresh=args.refresh, trace=args.trace)
     if progress:
         print(file=sys.stderr)
     state = f"{'certified' if start.certified else 'NOT certified'} complete: {start.how}"
     if not start.traced and start.count <= MAX_SOLUTIONS and start.generic != start.count:
         state += "; --trace runs the trace test"
-    print(f"{chain.name}: start system of {start.count} complex solutions, {state}; runs found {start.runs} "
-          f"in {start.loops} loops ({start.seconds:.1f} s to compute; cached)")
+    print(
+        f"{chain.name}: start system of {start.count} complex solutions, {state}; runs found {start.runs} "
+        f"in {start.loops} loops ({start.seconds:.1f} s to compute; cached)"
+    )
     return 0
 
 
@@ -109,8 +118,16 @@ def _cmd_fk(args) -> int:
 def _cmd_demo(args) -> int:
     motion = polynomials.load("apair_motion")
     print("The A-pair, derived from the six leg constraints of a Griffis-Duffy platform:")
-    for label in ("consistency", "a", "b", "pair_quadric", "law", "sinusoidal_L1", "sinusoidal_amplitude",
-                  "law_sinusoidal"):
+    for label in (
+        "consistency",
+        "a",
+        "b",
+        "pair_quadric",
+        "law",
+        "sinusoidal_L1",
+        "sinusoidal_amplitude",
+        "law_sinusoidal",
+    ):
         e = motion[label]
         print(f"  {label:22s} {e.lhs} = {e.rhs}" if hasattr(e, "rhs") else f"  {label:22s} {e} = 0")
     if args.file:
@@ -131,11 +148,22 @@ def _cmd_variety(args) -> int:
     chain = load(args.file)
     V = chain.constraint_variety()
     if args.json:
-        print(json.dumps({
-            "chain": chain.name, "exact": V.exact, "degree": V.degree, "residual": V.residual,
-            "hilbert": V.hilbert, "dims": V.dims,
-            "equations": [{"degree": P.total_degree(), "terms": len(P.terms()), "expr": sp.sstr(P.as_expr())} for P in V],
-        }, indent=1))
+        print(
+            json.dumps(
+                {
+                    "chain": chain.name,
+                    "exact": V.exact,
+                    "degree": V.degree,
+                    "residual": V.residual,
+                    "hilbert": V.hilbert,
+                    "dims": V.dims,
+                    "equations": [
+                        {"degree": P.total_degree(), "terms": len(P.terms()), "expr": sp.sstr(P.as_expr())} for P in V
+                    ],
+                },
+                indent=1,
+            )
+        )
         return 0
     kind = "exact" if V.exact else f"floating point, residual {V.residual:.2e}"
     print(f"{chain.name}: constraint variety ({kind}); surface of degree {V.degree}")
@@ -154,8 +182,9 @@ def _parse_pose(values) -> np.ndarray:
         return np.vstack([x.reshape(3, 4), [0.0, 0.0, 0.0, 1.0]])
     if len(x) == 8:
         return x
-    raise ValueError(f"POSE: expected 16 (or 12) numbers of a 4x4 transform, row by row, or the 8 of a "
-                     f"Study point, got {len(x)}")
+    raise ValueError(
+        f"POSE: expected 16 (or 12) numbers of a 4x4 transform, row by row, or the 8 of a Study point, got {len(x)}"
+    )
 
 
 def _cmd_ik(args) -> int:
@@ -168,13 +197,17 @@ def _cmd_ik(args) -> int:
         if len(sol.q) == 0:
             dp, dr, q = distance(chain, T)
             why = "" if sol.certified else " (not certified complete)"
-            print(f"{chain.name}: the pose is unreachable{why}. The nearest pose found inside the joint limits "
-                  f"(q = {q} rad) is {dp:.3e} m and {dr:.3e} rad away.")
+            print(
+                f"{chain.name}: the pose is unreachable{why}. The nearest pose found inside the joint limits "
+                f"(q = {q} rad) is {dp:.3e} m and {dr:.3e} rad away."
+            )
             return 1
         complete = "" if sol.certified else "; not certified complete"
         count = f" of {sol.complex_count} complex" if sol.complex_count is not None else ""
-        print(f"{chain.name}: {len(sol.q)} real solution(s){count}, by {sol.method}{complete}; angles in rad"
-              f"{' and deg' if args.deg else ''}")
+        print(
+            f"{chain.name}: {len(sol.q)} real solution(s){count}, by {sol.method}{complete}; angles in rad"
+            f"{' and deg' if args.deg else ''}"
+        )
         for q, e, ok in zip(sol.q, sol.error, sol.inside):
             extra = f"  = {np.degrees(q)} deg" if args.deg else ""
             print(f"  q = {q}{extra}   |fk(q) - T| = {e:.1e}   {'within' if ok else 'OUTSIDE'} the joint limits")
@@ -206,13 +239,21 @@ def _cmd_workspace(args) -> int:
         from .files import target
 
         target(args.plot, args.force)  # refuse before the long run, not after it
-    ws = chain.workspace(samples=args.samples, resolution=args.resolution, engine=args.scheduler,
-                         progress=text_progress() if not args.quiet else None)
-    print(f"{chain.name}: workspace {ws.summary} from {len(ws.points)} samples; voxel {ws.voxel:.3g} m, "
-          f"{len(ws.boundary)} boundary voxels")
+    ws = chain.workspace(
+        samples=args.samples,
+        resolution=args.resolution,
+        engine=args.scheduler,
+        progress=text_progress() if not args.quiet else None,
+    )
+    print(
+        f"{chain.name}: workspace {ws.summary} from {len(ws.points)} samples; voxel {ws.voxel:.3g} m, "
+        f"{len(ws.boundary)} boundary voxels"
+    )
     lo, hi = ws.points.min(axis=0), ws.points.max(axis=0)
-    print(f"  bounding box [m]: x {lo[0]:+.4f} .. {hi[0]:+.4f}, y {lo[1]:+.4f} .. {hi[1]:+.4f}, "
-          f"z {lo[2]:+.4f} .. {hi[2]:+.4f}")
+    print(
+        f"  bounding box [m]: x {lo[0]:+.4f} .. {hi[0]:+.4f}, y {lo[1]:+.4f} .. {hi[1]:+.4f}, "
+        f"z {lo[2]:+.4f} .. {hi[2]:+.4f}"
+    )
     if args.plot:
         print(f"  picture written to {ws.plot(args.plot, overwrite=args.force)}")
     return 0
@@ -227,8 +268,10 @@ def _cmd_export(args) -> int:
     xml = mjcf.to_mjcf(chain, q, name=chain.name or os.path.basename(args.file), collisions=args.collisions)
     out = write_text(args.out, xml, args.force, ".xml")
     legs = sum(6 for p in chain.pairs if p.kind != "revolute")
-    print(f"{chain.name}: MuJoCo model written to {out} ({chain.n} pairs, {legs} legs closed by "
-          f"{legs} connect constraints; keyframe 0 at q = {np.round(q if q is not None else np.zeros(chain.n), 6).tolist()})")
+    print(
+        f"{chain.name}: MuJoCo model written to {out} ({chain.n} pairs, {legs} legs closed by "
+        f"{legs} connect constraints; keyframe 0 at q = {np.round(q if q is not None else np.zeros(chain.n), 6).tolist()})"
+    )
     return 0
 
 
@@ -260,11 +303,14 @@ def _cmd_codegen(args) -> int:
     chain = load(args.file)
     name = specialise.check_prefix(args.prefix) if args.prefix else specialise.prefix_from(args.file)
     kernels = None if args.kernels is None else [k.strip() for k in args.kernels.split(",") if k.strip()]
-    changed = specialise.write_code(chain, args.out, name, os.path.basename(args.file), kernels,
-                                    title=chain.name, force=args.force)
+    changed = specialise.write_code(
+        chain, args.out, name, os.path.basename(args.file), kernels, title=chain.name, force=args.force
+    )
     notes = [c for c in changed if c.startswith("kept ")]
-    print(f"apair codegen: {name} ({chain.n} joints) in {args.out}: {len(changed) - len(notes)} files written, "
-          f"changed or removed ({time.perf_counter() - t0:.1f} s)")
+    print(
+        f"apair codegen: {name} ({chain.n} joints) in {args.out}: {len(changed) - len(notes)} files written, "
+        f"changed or removed ({time.perf_counter() - t0:.1f} s)"
+    )
     for note in notes:
         print(f"  {note}")
     return 0
@@ -277,8 +323,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("list", help="list the derived polynomial sets")
     p.set_defaults(func=_cmd_list)
     p = sub.add_parser("show", help="print a derived polynomial set")
-    p.add_argument("name", help="a set from `apair list`, e.g. apair_motion, or ik_counts (the inverse "
-                   "kinematics solution counts)")
+    p.add_argument(
+        "name", help="a set from `apair list`, e.g. apair_motion, or ik_counts (the inverse kinematics solution counts)"
+    )
     g = p.add_mutually_exclusive_group()
     g.add_argument("--latex", action="store_true", help="LaTeX instead of text")
     g.add_argument("--json", action="store_true", help="the machine-readable form")
@@ -296,19 +343,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_variety)
     p = sub.add_parser("ik", help="all inverse kinematics solutions of a chain file at a pose")
     p.add_argument("file", help="a chain TOML file (1 to 6 sinusoidal A-pairs or R-pairs)")
-    p.add_argument("pose", nargs="+", metavar="POSE",
-                   help="a 4x4 transform row by row (16 numbers, or the top 12) or a Study point (8)")
+    p.add_argument(
+        "pose",
+        nargs="+",
+        metavar="POSE",
+        help="a 4x4 transform row by row (16 numbers, or the top 12) or a Study point (8)",
+    )
     p.add_argument("--deg", action="store_true", help="also print the angles in degrees")
     p.set_defaults(func=_cmd_ik)
-    p = sub.add_parser("ik-prepare", help="the homotopy start system of a 5- or 6-joint chain file (cached)",
-                       description="Find every complex inverse-kinematics solution at a generic complex pose by "
-                       "monodromy and cache it under the design's content hash, so that `ik` need not.")
+    p = sub.add_parser(
+        "ik-prepare",
+        help="the homotopy start system of a 5- or 6-joint chain file (cached)",
+        description="Find every complex inverse-kinematics solution at a generic complex pose by "
+        "monodromy and cache it under the design's content hash, so that `ik` need not.",
+    )
     p.add_argument("file", help="a chain TOML file (5 or 6 sinusoidal A-pairs or R-pairs)")
     p.add_argument("--refresh", action="store_true", help="compute it again even if it is cached")
     p.add_argument("--quiet", action="store_true", help="no progress line")
-    p.add_argument("--trace", action="store_true",
-                   help="also certify the set by the trace test (seconds for up to 48 solutions, minutes and "
-                   "possibly no verdict for more, refused above 200; cached)")
+    p.add_argument(
+        "--trace",
+        action="store_true",
+        help="also certify the set by the trace test (seconds for up to 48 solutions, minutes and "
+        "possibly no verdict for more, refused above 200; cached)",
+    )
     p.set_defaults(func=_cmd_ik_prepare)
     p = sub.add_parser("limits", help="joint ranges of a chain file: explicit, or the pairs' collision limits")
     p.add_argument("file", help="a chain TOML file")
@@ -321,25 +378,40 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true", help="replace an existing picture")
     p.add_argument("--samples", type=int, default=300_000, help="joint samples (default 300000)")
     p.add_argument("--resolution", type=int, default=24, help="voxels along the longest side (default 24)")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="run on a dask.distributed scheduler (or 'threads', 'processes')")
+    p.add_argument(
+        "--scheduler", metavar="ADDRESS", help="run on a dask.distributed scheduler (or 'threads', 'processes')"
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_workspace)
-    p = sub.add_parser("codegen", help="C and NumPy code for one chain file, its design built in",
-                       description="Write NAME.h, NAME.c (C99, libm), NAME.py (NumPy), NAME_selftest.c, "
-                       "CMakeLists.txt (target NAME::NAME) and NAME.pc.in for the chain into --out.")
+    p = sub.add_parser(
+        "codegen",
+        help="C and NumPy code for one chain file, its design built in",
+        description="Write NAME.h, NAME.c (C99, libm), NAME.py (NumPy), NAME_selftest.c, "
+        "CMakeLists.txt (target NAME::NAME) and NAME.pc.in for the chain into --out.",
+    )
     p.add_argument("file", help="a chain TOML file")
-    p.add_argument("--out", required=True, metavar="DIR",
-                   help="output folder: new, empty, or written by an earlier apair codegen")
+    p.add_argument(
+        "--out", required=True, metavar="DIR", help="output folder: new, empty, or written by an earlier apair codegen"
+    )
     p.add_argument("--prefix", metavar="NAME", help="name of the files and functions (default: from the file name)")
-    p.add_argument("--kernels", metavar="LIST",
-                   help="comma-separated subset of fk, fk_study, jacobian, mass_matrix, coriolis, gravity_torques, "
-                   "bias, inverse_dynamics, forward_dynamics, energy (default: all)")
-    p.add_argument("--force", action="store_true",
-                   help="replace files in --out that an earlier apair codegen did not write (never through a link)")
+    p.add_argument(
+        "--kernels",
+        metavar="LIST",
+        help="comma-separated subset of fk, fk_study, jacobian, mass_matrix, coriolis, gravity_torques, "
+        "bias, inverse_dynamics, forward_dynamics, energy (default: all)",
+    )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="replace files in --out that an earlier apair codegen did not write (never through a link)",
+    )
     p.set_defaults(func=_cmd_codegen)
-    p = sub.add_parser("export", help="the chain in another tool's format: mjcf (a MuJoCo model)",
-                       description="Write a MuJoCo model (MJCF) of the chain's mechanism: every A-pair as its "
-                       "Griffis-Duffy platform, legs as bodies closed by equality constraints, motors on the pair axes.")
+    p = sub.add_parser(
+        "export",
+        help="the chain in another tool's format: mjcf (a MuJoCo model)",
+        description="Write a MuJoCo model (MJCF) of the chain's mechanism: every A-pair as its "
+        "Griffis-Duffy platform, legs as bodies closed by equality constraints, motors on the pair axes.",
+    )
     p.add_argument("format", choices=["mjcf"], help="the format (mjcf: MuJoCo XML)")
     p.add_argument("file", help="a chain TOML file")
     p.add_argument("out", help="the file to write (.xml)")
@@ -348,10 +420,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--collisions", action="store_true", help="let plates and legs collide (off by default)")
     p.add_argument("--force", action="store_true", help="replace an existing file")
     p.set_defaults(func=_cmd_export)
-    p = sub.add_parser("view", help="an interactive 3D view of a chain file: one offline HTML page",
-                       description="Write one self-contained HTML page: the mechanism in 3D (plates, legs, links, "
-                       "frames), a slider per joint within the chain's limits, the end-effector pose and each "
-                       "pair's clearance, computed in the page by the generated JavaScript kernels.")
+    p = sub.add_parser(
+        "view",
+        help="an interactive 3D view of a chain file: one offline HTML page",
+        description="Write one self-contained HTML page: the mechanism in 3D (plates, legs, links, "
+        "frames), a slider per joint within the chain's limits, the end-effector pose and each "
+        "pair's clearance, computed in the page by the generated JavaScript kernels.",
+    )
     p.add_argument("file", help="a chain TOML file")
     p.add_argument("--out", default="view.html", metavar="HTML", help="the page to write (default view.html)")
     p.add_argument("--workspace", type=int, default=0, metavar="N", help="also N sampled end-effector points")
@@ -385,9 +460,12 @@ def main(argv=None) -> int:
     except (ValueError, OSError) as exc:
         print(f"apair {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
-    except Exception as exc:  # noqa: BLE001 (the CLI's promise: no traceback, a line to report)
-        print(f"apair {args.command}: internal error: {type(exc).__name__}: {_one_line(exc)} "
-              "(please report this with the command line)", file=sys.stderr)
+    except Exception as exc:
+        print(
+            f"apair {args.command}: internal error: {type(exc).__name__}: {_one_line(exc)} "
+            "(please report this with the command line)",
+            file=sys.stderr,
+        )
         return 3
 
 

@@ -16,6 +16,7 @@ and 4 add roots and a piece only counts inside its segments, so each root is a c
 touch when the true clearance there (segment distances − ρ, plate gap d − τ) is zero. The limits
 are the nearest touches on either side of θ = 0.
 """
+
 from __future__ import annotations
 
 import math
@@ -189,8 +190,13 @@ def unit_pair(pair):
     angles do not depend on scale)."""
     s = pair.base_radius + pair.platform_radius
     L1 = None if pair.kind == "sinusoidal" else pair.leg_lengths[0] / s
-    return type(pair)(pair.base_radius / s, pair.platform_radius / s, leg_length=L1, leg_radius=pair.leg_radius / s,
-                      thickness=pair.thickness / s)
+    return type(pair)(
+        pair.base_radius / s,
+        pair.platform_radius / s,
+        leg_length=L1,
+        leg_radius=pair.leg_radius / s,
+        thickness=pair.thickness / s,
+    )
 
 
 def limits(pair) -> CollisionLimits:
@@ -202,11 +208,15 @@ def limits(pair) -> CollisionLimits:
     legs0, plate0 = clearances(pair, np.array(0.0))
     if legs0.min() <= 0:
         i, j = LEG_PAIRS[int(np.argmin(legs0))]
-        raise ValueError(f"leg_radius: {pair.leg_radius} is too large, legs {i + 1} and {j + 1} overlap at theta = 0 "
-                         f"(the pair cannot move); the largest radius is {(legs0.min() + 2 * pair.leg_radius) / 2:.6g}")
+        raise ValueError(
+            f"leg_radius: {pair.leg_radius} is too large, legs {i + 1} and {j + 1} overlap at theta = 0 "
+            f"(the pair cannot move); the largest radius is {(legs0.min() + 2 * pair.leg_radius) / 2:.6g}"
+        )
     if plate0 <= 0:
-        raise ValueError(f"thickness: {pair.thickness} is not less than d(0) = {pair.translation(0.0):.6g}, "
-                         f"the plates overlap at theta = 0 (the pair cannot move)")
+        raise ValueError(
+            f"thickness: {pair.thickness} is not less than d(0) = {pair.translation(0.0):.6g}, "
+            f"the plates overlap at theta = 0 (the pair cannot move)"
+        )
     end = pair.theta_limit  # the range end of the pair itself (the unit pair's differs by rounding)
     pair, size = unit_pair(pair), 1.0
     r_b, r_p = _rational(pair.base_radius), _rational(pair.platform_radius)

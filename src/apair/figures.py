@@ -5,6 +5,7 @@ drawn by apair.plots, which offers these too.
 Every function writes a new file and refuses to replace an existing one unless overwrite=True
 (apair.files).
 """
+
 from __future__ import annotations
 
 import math
@@ -47,8 +48,15 @@ def clearance(pair, path, overwrite: bool = False, samples: int = 2001) -> Path:
     for value, side in ((lim.theta_min, "min"), (lim.theta_max, "max")):
         if math.isfinite(value):
             ax.axvline(math.degrees(value), color="C3", ls="--", lw=1)
-            ax.annotate(f"θ_{side} = {math.degrees(value):.3f}°", (math.degrees(value), 0), xytext=(4, 8),
-                        textcoords="offset points", color="C3", rotation=90, va="bottom")
+            ax.annotate(
+                f"θ_{side} = {math.degrees(value):.3f}°",
+                (math.degrees(value), 0),
+                xytext=(4, 8),
+                textcoords="offset points",
+                color="C3",
+                rotation=90,
+                va="bottom",
+            )
     ax.set_xlabel("θ [deg]")
     ax.set_ylabel("clearance [mm]")
     ax.set_title(f"{pair!r}: first touch {lim.what}", fontsize=9)
@@ -71,8 +79,11 @@ def workspace(ws, path, overwrite: bool = False, max_points: int = 20_000) -> Pa
     ax = fig.add_subplot(2, 2, 1, projection="3d")
     ax.scatter(*show.T, s=0.3, alpha=0.3)
     axes_3d(ax, pts)
-    what = (f"V = {ws.volume:.4g} ± {ws.volume_error:.2g} m³" if ws.dimension == 3 else
-            f"{'curve, length' if ws.dimension == 1 else 'surface, area'} ≈ {ws.measure:.4g} m{'' if ws.dimension == 1 else '²'}")
+    what = (
+        f"V = {ws.volume:.4g} ± {ws.volume_error:.2g} m³"
+        if ws.dimension == 3
+        else f"{'curve, length' if ws.dimension == 1 else 'surface, area'} ≈ {ws.measure:.4g} m{'' if ws.dimension == 1 else '²'}"
+    )
     ax.set_title(f"{ws.chain_name}: {what} ({len(pts)} samples)", fontsize=9)
     names = "xyz"
     for k, axis in enumerate(range(3)):
@@ -110,7 +121,7 @@ def axes_3d(ax, pts) -> float:
 
     extent = _equal_3d(ax, pts)
     ax.set_box_aspect((1, 1, 1))
-    for name, axis in zip("xyz", (ax.xaxis, ax.yaxis, ax.zaxis)):
+    for _name, axis in zip("xyz", (ax.xaxis, ax.yaxis, ax.zaxis)):
         axis.set_major_locator(MaxNLocator(4))
         axis.set_tick_params(labelsize=8)
     ax.set_xlabel("x [m]", fontsize=9)
@@ -127,4 +138,3 @@ def _equal_3d(ax, pts) -> float:
     ax.set_ylim(c[1] - r, c[1] + r)
     ax.set_zlim(c[2] - r, c[2] + r)
     return r
-

@@ -6,13 +6,14 @@ file is replaced only with overwrite=True (never written through a symlink). Wha
 once and keeps (compiled specialised chains, inverse-kinematics start systems) goes into the cache
 (`cache_root`), keyed by content hashes that include the toolkit that made it (`toolkit_digest`).
 """
+
 from __future__ import annotations
 
 import hashlib
 import os
 import shutil
 import tempfile
-from functools import lru_cache
+from functools import cache
 from importlib import resources
 from pathlib import Path
 
@@ -84,7 +85,7 @@ def cache_root() -> Path:
     return Path(base) / "apair"
 
 
-@lru_cache(maxsize=None)
+@cache
 def toolkit_digest() -> str:
     """SHA-256 of what turns a design into code: the derivations, the code generator with its
     templates, apair's and sympy's versions (sympy's printing and evaluation shape the output)."""

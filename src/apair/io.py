@@ -1,24 +1,25 @@
 """Chains from TOML files (the format is documented in README.md, "Chain files").
 
-    name = "a 2A-chain"            # optional
-    [[joint]]                      # one table per joint, base to tip
-    pair = "sinusoidal"            # "sinusoidal" | "general" | "revolute"
-    base_radius = 0.05             # A-pairs: triangle circumradii [m]
-    platform_radius = 0.05
-    leg_length = 0.08              # "general" only: L1 [m]
-    leg_mass = 0.0                 # optional [kg]; leg_radius = 0.0, thickness = 0.0 optional [m]
-    limits = [-1.0, 1.0]           # optional joint range [rad] (or limits_deg); default: the
-                                   # pair's collision limits (a full turn for an R-pair)
-    a = 0.3                        # DH link length [m]
-    alpha = 1.5707963267948966     # DH twist [rad], or alpha_deg = 90
-    offset = 0.0                   # c_i [m] (optional)
-    theta_offset = 0.0             # phi_i [rad] (optional), or theta_offset_deg
-    mass = 1.0                     # link i (optional): mass [kg], centre of mass in frame i [m],
-    com = [0.0, 0.0, 0.05]         # inertia about the centre of mass in frame i [kg m^2]:
-    inertia = [0.01, 0.01, 0.02]   # principal (Ixx, Iyy, Izz), six values (Ixx, Iyy, Izz, Ixy,
-                                   # Ixz, Iyz) or a 3x3 table
-    gravity = [0, 0, -9.81]        # top level, optional [m/s^2]
+name = "a 2A-chain"            # optional
+[[joint]]                      # one table per joint, base to tip
+pair = "sinusoidal"            # "sinusoidal" | "general" | "revolute"
+base_radius = 0.05             # A-pairs: triangle circumradii [m]
+platform_radius = 0.05
+leg_length = 0.08              # "general" only: L1 [m]
+leg_mass = 0.0                 # optional [kg]; leg_radius = 0.0, thickness = 0.0 optional [m]
+limits = [-1.0, 1.0]           # optional joint range [rad] (or limits_deg); default: the
+                               # pair's collision limits (a full turn for an R-pair)
+a = 0.3                        # DH link length [m]
+alpha = 1.5707963267948966     # DH twist [rad], or alpha_deg = 90
+offset = 0.0                   # c_i [m] (optional)
+theta_offset = 0.0             # phi_i [rad] (optional), or theta_offset_deg
+mass = 1.0                     # link i (optional): mass [kg], centre of mass in frame i [m],
+com = [0.0, 0.0, 0.05]         # inertia about the centre of mass in frame i [kg m^2]:
+inertia = [0.01, 0.01, 0.02]   # principal (Ixx, Iyy, Izz), six values (Ixx, Iyy, Izz, Ixy,
+                               # Ixz, Iyz) or a 3x3 table
+gravity = [0, 0, -9.81]        # top level, optional [m/s^2]
 """
+
 from __future__ import annotations
 
 import math
@@ -92,8 +93,10 @@ def _limits(where: str, j: dict, pair: APair):
                 raise ValueError(f"{where}.{key}: expected lo < hi, got ({lo:g}, {hi:g}) {unit}")
             plo, phi = pair.motion_range()
             if lo * scale < plo or hi * scale > phi:
-                raise ValueError(f"{where}.{key}: ({lo:g}, {hi:g}) {unit} goes beyond the pair's collision-free "
-                                 f"range ({plo / scale:.6g}, {phi / scale:.6g}) {unit}")
+                raise ValueError(
+                    f"{where}.{key}: ({lo:g}, {hi:g}) {unit} goes beyond the pair's collision-free "
+                    f"range ({plo / scale:.6g}, {phi / scale:.6g}) {unit}"
+                )
             return lo * scale, hi * scale
     return None
 

@@ -7,13 +7,14 @@ at install time), are the default; the generated NumPy kernels are used on reque
 missing, which is said once. Kernel signatures come from generated/manifest.json and the C
 registry, so nothing here is written per kernel.
 """
+
 from __future__ import annotations
 
 import importlib
 import json
 import os
 import warnings
-from functools import lru_cache
+from functools import cache
 from importlib import resources
 
 import numpy as np
@@ -22,13 +23,13 @@ _BACKENDS = ("c", "numpy")
 _state = {"backend": None, "warned": False, "resolved": None}
 
 
-@lru_cache(maxsize=None)
+@cache
 def manifest() -> dict:
     """Names, inputs, outputs and op counts of every generated kernel."""
     return json.loads(resources.files("apair.generated").joinpath("manifest.json").read_text())
 
 
-@lru_cache(maxsize=None)
+@cache
 def _native():
     """The extension module with the compiled kernels, or None (with the reason)."""
     try:
@@ -38,9 +39,11 @@ def _native():
     m = manifest()
     built = (module.content_hash, getattr(module, "sources_hash", None))
     if built != (m["content_hash"], m["sources_hash"]):
-        return None, (f"the compiled C kernels (apair._native, content {built[0]}, sources {built[1]}) were built "
-                      f"from other generated C sources than the manifest's (content {m['content_hash']}, sources "
-                      f"{m['sources_hash']}): reinstall apair")
+        return None, (
+            f"the compiled C kernels (apair._native, content {built[0]}, sources {built[1]}) were built "
+            f"from other generated C sources than the manifest's (content {m['content_hash']}, sources "
+            f"{m['sources_hash']}): reinstall apair"
+        )
     return module, None
 
 
@@ -105,7 +108,7 @@ def _resolve_backend() -> str:
     return "numpy"
 
 
-@lru_cache(maxsize=None)
+@cache
 def _c_table(native) -> dict[str, int]:
     """Kernel name → registry index of the extension module, built whole before it is returned
     (threads calling for the first time never see a half-filled table)."""
@@ -120,7 +123,7 @@ def _c_index(native, name: str) -> int:
         raise ValueError(f"kernel: no generated kernel called {name!r}") from None
 
 
-@lru_cache(maxsize=None)
+@cache
 def _numpy_function(name: str):
     from apair.generated.numpy import KERNELS
 
@@ -134,11 +137,13 @@ def _canonical(name: str, inputs) -> list[np.ndarray]:
     arrays = [_float64(name, a["name"], x) for x, a in zip(inputs, spec)]
     shapes = [tuple(a["shape"]) for a in spec]
     for x, s, a in zip(arrays, shapes, spec):
-        if x.ndim < len(s) or x.shape[x.ndim - len(s):] != s:
+        if x.ndim < len(s) or x.shape[x.ndim - len(s) :] != s:
             raise ValueError(f"{name}: input {a['name']} must end in shape {s}, got {x.shape}")
     batch = np.broadcast_shapes(*(x.shape[: x.ndim - len(s)] for x, s in zip(arrays, shapes)))
-    return [np.require(x if x.ndim == len(s) else np.broadcast_to(x, batch + s), requirements=("C", "A"))
-            for x, s in zip(arrays, shapes)]
+    return [
+        np.require(x if x.ndim == len(s) else np.broadcast_to(x, batch + s), requirements=("C", "A"))
+        for x, s in zip(arrays, shapes)
+    ]
 
 
 def _input_spec(name: str, inputs) -> list[dict]:
@@ -200,6 +205,11 @@ def native_chain(n: int, methods, laws, limits, design: dict, keep=None, table=N
         index = {name: i for i, name in enumerate(names)}
         address = lambda name: base + index[name] * native.KERNEL_SIZE if name in index else None
     generic = lambda name: native.kernel_address(_c_index(native, name))
-    return native.Chain(n, [(address(name), bool(strict)) for name, strict in methods],
-                        [(generic(name), tuple(float(x) for x in params)) for name, params in laws],
-                        [float(x) for x in limits], dict(design), keep)
+    return native.Chain(
+        n,
+        [(address(name), bool(strict)) for name, strict in methods],
+        [(generic(name), tuple(float(x) for x in params)) for name, params in laws],
+        [float(x) for x in limits],
+        dict(design),
+        keep,
+    )

@@ -1,4 +1,5 @@
 """`Link`: the rigid body carrying pair i's platform and frame i (docs/conventions.md §4)."""
+
 from __future__ import annotations
 
 import numpy as np

@@ -23,6 +23,7 @@ the configuration q, legs included (`state`). MuJoCo needs mass and inertia in e
 massless legs and links get MASSLESS × the model's mass scale, and a singular link inertia a floor
 of 1e-2 times that (kg m²); both change the dynamics by about MASSLESS.
 """
+
 from __future__ import annotations
 
 import math
@@ -112,8 +113,10 @@ def state(chain, q, qd=None) -> tuple[np.ndarray, np.ndarray]:
             continue
         d, dd = pair.law(q[i])[:2]
         if not (d > FLAT * max(pair.base_radius, pair.platform_radius) and np.isfinite(dd)):
-            raise ValueError(f"q: pair {i + 1} is at d = 0 (legs flat, q[{i}] = {q[i]!r}), where the loops leave "
-                             "the legs' positions and rates undetermined")
+            raise ValueError(
+                f"q: pair {i + 1} is at d = 0 (legs flat, q[{i}] = {q[i]!r}), where the loops leave "
+                "the legs' positions and rates undetermined"
+            )
         base, length, frames = _reference_legs(pair)
         top = pair.leg_endpoints(q[i])[:, 1]
         for k in range(6):
@@ -177,8 +180,10 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
     def rod(indent, label, a, b, radius, rgba="0.75 0.55 0.3 1"):
         if np.linalg.norm(np.asarray(b) - a) < 1e-12:
             return
-        out.append(f'{indent}<geom name="{label}" type="capsule" fromto="{_f(np.concatenate([a, b]))}" '
-                   f'size="{_f(radius)}" {col} rgba="{rgba}"/>')
+        out.append(
+            f'{indent}<geom name="{label}" type="capsule" fromto="{_f(np.concatenate([a, b]))}" '
+            f'size="{_f(radius)}" {col} rgba="{rgba}"/>'
+        )
 
     # frame i−1 in the current body: (R, p); the world carries frame 0
     R_prev, p_prev = np.eye(3), np.zeros(3)
@@ -187,7 +192,9 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
         n1 = i + 1
         size = _size(chain, i)
         quat_prev = _quat(R_prev)
-        out.append(f'{indent}<site name="pair{n1}_base" pos="{_f(p_prev)}" quat="{_f(quat_prev)}" size="{_f(0.1 * size)}"/>')
+        out.append(
+            f'{indent}<site name="pair{n1}_base" pos="{_f(p_prev)}" quat="{_f(quat_prev)}" size="{_f(0.1 * size)}"/>'
+        )
         h0 = 0.0
         if pair.kind != "revolute":
             h0 = pair.translation(0.0)
@@ -201,15 +208,21 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
                 R0 = R_prev @ frames[k]
                 m = pair.leg_mass
                 It = m * L * L / 12
-                Is = 0.5 * m * pair.leg_radius ** 2 if pair.leg_radius > 0 else SPIN * It
-                out.append(f'{indent}<body name="pair{n1}_leg{k + 1}" pos="{_f(p_prev + R_prev @ base[k])}" '
-                           f'quat="{_f(_quat(R0))}">')
+                Is = 0.5 * m * pair.leg_radius**2 if pair.leg_radius > 0 else SPIN * It
+                out.append(
+                    f'{indent}<body name="pair{n1}_leg{k + 1}" pos="{_f(p_prev + R_prev @ base[k])}" '
+                    f'quat="{_f(_quat(R0))}">'
+                )
                 out.append(f'{indent}  <joint name="pair{n1}_leg{k + 1}_ball" type="ball"/>')
                 if m > 0:
-                    out.append(f'{indent}  <inertial pos="0 0 {_f(L / 2)}" mass="{_f(m)}" diaginertia="{_f([It, It, Is])}"/>')
+                    out.append(
+                        f'{indent}  <inertial pos="0 0 {_f(L / 2)}" mass="{_f(m)}" diaginertia="{_f([It, It, Is])}"/>'
+                    )
                 else:
-                    out.append(f'{indent}  <inertial pos="0 0 {_f(L / 2)}" mass="{_f(tiny)}" '
-                               f'diaginertia="{_f([tiny * L * L / 12] * 3)}"/>')
+                    out.append(
+                        f'{indent}  <inertial pos="0 0 {_f(L / 2)}" mass="{_f(tiny)}" '
+                        f'diaginertia="{_f([tiny * L * L / 12] * 3)}"/>'
+                    )
                 radius = pair.leg_radius if pair.leg_radius > 0 else VISUAL_RADIUS * size
                 rod(indent + "  ", f"pair{n1}_leg{k + 1}_rod", np.zeros(3), np.array([0, 0, L]), radius)
                 out.append(f"{indent}</body>")
@@ -220,8 +233,9 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
         out.append(f'{ind}<joint name="pair{n1}_theta" type="hinge" axis="0 0 1"/>')
         if pair.kind != "revolute":
             top = float(max(pair.translation(np.linspace(*pair.motion_range(), 721)).max(), h0))
-            out.append(f'{ind}<joint name="pair{n1}_d" type="slide" axis="0 0 1" ref="{_f(h0)}" '
-                       f'range="0 {_f(2 * top)}"/>')
+            out.append(
+                f'{ind}<joint name="pair{n1}_d" type="slide" axis="0 0 1" ref="{_f(h0)}" range="0 {_f(2 * top)}"/>'
+            )
         R_off, p_off = _link_offset(chain, i)
         link = chain.links[i]
         inertial(ind, link.mass, p_off + R_off @ link.com, R_off, link.inertia)
@@ -235,7 +249,7 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
         R_prev, p_prev = R_off, p_off
         indent = ind
     out.append(f'{indent}<site name="end_effector" pos="{_f(p_prev)}" quat="{_f(_quat(R_prev))}" size="0.01"/>')
-    for i in reversed(range(chain.n)):
+    for _ in range(chain.n):
         indent = indent[:-2]
         out.append(f"{indent}</body>")
 
@@ -248,8 +262,10 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
         if pair.kind == "revolute":
             continue
         for k, L in enumerate(_reference_legs(pair)[1]):
-            eq.append(f'    <connect name="pair{n1}_loop{k + 1}" body1="pair{n1}_leg{k + 1}" body2="link{n1}" '
-                      f'anchor="0 0 {_f(L)}"/>')
+            eq.append(
+                f'    <connect name="pair{n1}_loop{k + 1}" body1="pair{n1}_leg{k + 1}" body2="link{n1}" '
+                f'anchor="0 0 {_f(L)}"/>'
+            )
     g = chain.gravity
     lines = [
         f"<mujoco model={quoteattr(name)}>",
@@ -263,8 +279,11 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
         f'    <equality solref="{_f(SOLREF)}" solimp="{_f(SOLIMP)}"/>',
         "  </default>",
     ]
-    assets.insert(0, '    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.85 0.88 0.92" '
-                     'rgb2="0.55 0.6 0.68" width="64" height="64"/>')
+    assets.insert(
+        0,
+        '    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.85 0.88 0.92" '
+        'rgb2="0.55 0.6 0.68" width="64" height="64"/>',
+    )
     lines += ["  <asset>"] + assets + ["  </asset>"]
     lines += ["  <worldbody>"] + out + ["  </worldbody>"]
     if eq:
@@ -285,4 +304,3 @@ def joint_order(chain) -> list[str]:
         if pair.kind != "revolute":
             names.append(f"pair{n1}_d")
     return names
-

@@ -3,6 +3,7 @@
 The pair's constants (L2, a, b, h) and its law d(θ), d'(θ), d''(θ) come from the generated kernels
 of derivations/apair_pair.py; this module only validates and dispatches.
 """
+
 from __future__ import annotations
 
 import math
@@ -25,8 +26,10 @@ def _length(name: str, value, positive: bool = False) -> float:
     x = V.scalar(name, value, positive=positive, nonnegative=True)
     lo, hi = LENGTH_RANGE
     if x > hi or (x != 0 and x < lo):
-        raise ValueError(f"{name}: {x!r} m is outside the range {lo:g} .. {hi:g} m in which the pair's "
-                         "constants (squares and products of lengths) are finite doubles")
+        raise ValueError(
+            f"{name}: {x!r} m is outside the range {lo:g} .. {hi:g} m in which the pair's "
+            "constants (squares and products of lengths) are finite doubles"
+        )
     return x
 
 
@@ -56,7 +59,8 @@ class APair:
                 lo = math.sqrt(r_b**2 + r_p**2 / 4 - r_b * r_p) if r_b**2 + r_p**2 / 4 > r_b * r_p else 0.0
                 raise ValueError(
                     f"leg_length: L1 = {L1} admits no real pose of this pair (need a + b > 0, i.e. "
-                    f"L1 > {lo:.6g} for base_radius={r_b}, platform_radius={r_p})")
+                    f"L1 > {lo:.6g} for base_radius={r_b}, platform_radius={r_p})"
+                )
             L2 = math.sqrt(L2_sq)
             self.kind = "sinusoidal" if abs(a - b) <= _SINUSOIDAL_RTOL * b else "general"
             h = math.sqrt(2 * b) if self.kind == "sinusoidal" else None
@@ -65,7 +69,7 @@ class APair:
         self._h = float(h) if h is not None else None
 
     @classmethod
-    def revolute(cls) -> "APair":
+    def revolute(cls) -> APair:
         """An R-pair: no translation (d ≡ 0) and no legs."""
         self = cls.__new__(cls)
         self.kind = "revolute"
@@ -151,7 +155,8 @@ class APair:
                 if np.any(far):
                     raise ValueError(
                         f"{name}: outside this pair's range |theta| <= {self.theta_limit:.12g} (mod 2 pi), "
-                        f"e.g. {th[far].flat[0]!r}")
+                        f"e.g. {th[far].flat[0]!r}"
+                    )
                 turns = 2 * np.pi * np.round(th / (2 * np.pi))
                 th = np.where(bad, turns + np.copysign(self.theta_limit, th - turns), th)
         return th
@@ -197,7 +202,9 @@ class APair:
         try:
             shape = np.broadcast_shapes(th.shape, qd.shape, qdd.shape)
         except ValueError:
-            raise ValueError(f"qd: shapes {th.shape}, {qd.shape}, {qdd.shape} of theta, qd, qdd do not broadcast") from None
+            raise ValueError(
+                f"qd: shapes {th.shape}, {qd.shape}, {qdd.shape} of theta, qd, qdd do not broadcast"
+            ) from None
         th, qd, qdd = (np.broadcast_to(x, shape) for x in (th, qd, qdd))
         law = self._law(th)[..., 2:]
         if np.any(~np.isfinite(law)):

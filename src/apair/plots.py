@@ -3,6 +3,7 @@
 Every function writes a new file and refuses to replace an existing one unless overwrite=True.
 The pictures that need no chain (clearance, workspace) live in apair.figures and are offered here.
 """
+
 from __future__ import annotations
 
 import math
@@ -33,7 +34,9 @@ def segments(chain, q) -> list[tuple[np.ndarray, np.ndarray, str]]:
             for tri in (legs[:3, 0], legs[3:, 1]):  # base vertices, platform vertices
                 out += [(tri[k], tri[(k + 1) % 3], "plate") for k in range(3)]
         k = i + 1
-        T_next = AChain(chain.pairs[:k], chain.a[:k], chain.alpha[:k], chain.offset[:k], chain.theta_offset[:k]).fk(q[:k])
+        T_next = AChain(chain.pairs[:k], chain.a[:k], chain.alpha[:k], chain.offset[:k], chain.theta_offset[:k]).fk(
+            q[:k]
+        )
         out.append((T[:3, 3], T_next[:3, 3], "link"))
         T = T_next
     return out
@@ -43,7 +46,7 @@ def _triangles(segs) -> list[np.ndarray]:
     """The plates as filled triangles (3, 3) from a chain's segments: each A-pair's base and
     platform triangle (three edges each, one vertex at the start of each edge)."""
     starts = [a for a, _, kind in segs if kind == "plate"]
-    return [np.stack(starts[k: k + 3]) for k in range(0, len(starts), 3)]
+    return [np.stack(starts[k : k + 3]) for k in range(0, len(starts), 3)]
 
 
 def _draw(ax, chain, q, extent: float, segs=None):
@@ -70,7 +73,6 @@ def _draw(ax, chain, q, extent: float, segs=None):
     ax.scatter(*T[:3, 3, None], marker="^", s=50, color="C3", label="end effector")
     for axis, colour in zip(T[:3, :3].T, ("tab:red", "tab:green", "tab:blue")):
         ax.plot(*np.stack([T[:3, 3], T[:3, 3] + 0.15 * extent * axis]).T, color=colour, lw=1.2)
-
 
 
 def _scene_points(segs) -> np.ndarray:
@@ -117,8 +119,11 @@ def pair_animation(pair, path, frames: int = 48, overwrite: bool = False) -> Pat
         ax.cla()
         extent = axes_3d(ax, every)
         _draw(ax, chain, [angles[k]], extent)
-        ax.set_title(f"theta = {math.degrees(angles[k]):+7.2f} deg  (limits {math.degrees(lo):.1f}, "
-                     f"{math.degrees(hi):.1f}: {lim.what})", fontsize=8)
+        ax.set_title(
+            f"theta = {math.degrees(angles[k]):+7.2f} deg  (limits {math.degrees(lo):.1f}, "
+            f"{math.degrees(hi):.1f}: {lim.what})",
+            fontsize=8,
+        )
 
     anim = FuncAnimation(fig, frame, frames=len(angles))
     write(p, overwrite, lambda f: anim.save(f, writer=PillowWriter(fps=12)))

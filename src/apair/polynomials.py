@@ -1,8 +1,9 @@
 """The derived polynomial sets in generated/polynomials, loaded back as sympy objects."""
+
 from __future__ import annotations
 
 import json
-from functools import lru_cache
+from functools import cache
 from importlib import resources
 
 import sympy as sp
@@ -18,7 +19,7 @@ def names() -> list[str]:
     return sorted(p.name[:-5] for p in _dir().iterdir() if p.name.endswith(".json"))
 
 
-@lru_cache(maxsize=None)
+@cache
 def raw(name: str) -> dict:
     if name not in names():
         raise ValueError(f"name: no derived polynomial set {name!r}; known: {', '.join(names())}")
@@ -46,5 +47,7 @@ def load(name: str) -> dict[str, sp.Expr | sp.Eq]:
     out = {}
     for e in data["entries"]:
         lhs = parse_expr(e["lhs"], local_dict=local)
-        out[e["label"]] = lhs if e["rhs"] is None else sp.Eq(lhs, parse_expr(e["rhs"], local_dict=local), evaluate=False)
+        out[e["label"]] = (
+            lhs if e["rhs"] is None else sp.Eq(lhs, parse_expr(e["rhs"], local_dict=local), evaluate=False)
+        )
     return out

@@ -8,6 +8,7 @@ limits="ignore" the joints pass through explicit and collision limits (the legs 
 through each other), and only the end of a general pair's range of motion (d = 0, where the motion
 itself ends) stops the run.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -65,11 +66,14 @@ def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP
     bounds = _bounds(chain, limits)
     for i, (lo, hi) in enumerate(bounds):
         if not lo <= q0[i] <= hi:
-            raise ValueError(f"q0: joint {i + 1} at {q0[i]:.6g} rad is outside its limits ({lo:.6g}, {hi:.6g}) rad"
-                             + (" (limits='ignore' passes explicit and collision limits)" if limits == "stop" else ""))
+            raise ValueError(
+                f"q0: joint {i + 1} at {q0[i]:.6g} rad is outside its limits ({lo:.6g}, {hi:.6g}) rad"
+                + (" (limits='ignore' passes explicit and collision limits)" if limits == "stop" else "")
+            )
     if tau is None:
         torque = lambda _t, _q, _qd: np.zeros(n)
     elif callable(tau):
+
         def torque(tt, q, qd):
             out = V.real_array("tau", tau(tt, q, qd))
             if out.shape != (n,):
@@ -97,13 +101,23 @@ def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP
     for i, (lo, hi) in enumerate(inside):
         for side, value, sign in (("lower", lo, 1.0), ("upper", hi, -1.0)):
             if np.isfinite(value):
+
                 def event(_t, y, i=i, value=value, sign=sign):
                     return sign * (y[i] - value)
+
                 event.terminal, event.direction = True, -1
                 events.append(event)
                 which.append((i, side, bounds[i, 0 if side == "lower" else 1]))
-    sol = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([q0, qd0]), method=method, t_eval=t, rtol=rtol, atol=atol,
-                    events=events or None)
+    sol = solve_ivp(
+        rhs,
+        (t[0], t[-1]),
+        np.concatenate([q0, qd0]),
+        method=method,
+        t_eval=t,
+        rtol=rtol,
+        atol=atol,
+        events=events or None,
+    )
     if sol.status == -1:
         raise ValueError(f"t: the integration failed: {sol.message}")
     times, Y, stop = sol.t, sol.y, None

@@ -6,6 +6,7 @@ in), lowered and printed by the one emitter (codegen/emitter.py). Both ship insi
 package as apair.derivations and apair.codegen. The self-test's reference values are computed here
 by the generic runtime, so the generated code is checked against an independent evaluation.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -22,7 +23,8 @@ _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _C_KEYWORDS = frozenset(
     "auto break case char const continue default do double else enum extern float for goto if inline int long "
     "register restrict return short signed sizeof static struct switch typedef union unsigned void volatile while "
-    "bool true false class namespace new delete template this operator private public protected".split())
+    "bool true false class namespace new delete template this operator private public protected".split()
+)
 SELFTEST_STATES = 4
 
 
@@ -43,7 +45,8 @@ def design_of(chain):
         dh=tuple(tuple(float(x) for x in row) for row in chain._dh),
         links=tuple(tuple(float(x) for x in row) for row in chain._links),
         legs=tuple(tuple(float(x) for x in row) for row in chain._legs),
-        gravity=tuple(float(x) for x in chain.gravity))
+        gravity=tuple(float(x) for x in chain.gravity),
+    )
 
 
 def content_hash(chain, kernels) -> str:
@@ -56,8 +59,10 @@ def content_hash(chain, kernels) -> str:
 def check_prefix(name: str) -> str:
     """A prefix usable as C identifier stem and Python module name, or a ValueError."""
     if not isinstance(name, str) or not _IDENT.match(name) or len(name) > 48:
-        raise ValueError(f"prefix: expected a C identifier (letters, digits, _; not starting with a digit; at most "
-                         f"48 characters), got {name!r}")
+        raise ValueError(
+            f"prefix: expected a C identifier (letters, digits, _; not starting with a digit; at most "
+            f"48 characters), got {name!r}"
+        )
     if name in _C_KEYWORDS or keyword.iskeyword(name) or name.startswith("apair"):
         raise ValueError(f"prefix: {name!r} is a C, C++ or Python keyword or apair's own prefix")
     return name
@@ -78,7 +83,9 @@ def check_kernels(kernels) -> tuple[str, ...]:
     kernels = tuple(kernels)
     unknown = [k for k in kernels if k not in specialised.KERNELS]
     if unknown or not kernels:
-        raise ValueError(f"kernels: expected names from {', '.join(specialised.KERNELS)}, got {', '.join(kernels) or 'none'}")
+        raise ValueError(
+            f"kernels: expected names from {', '.join(specialised.KERNELS)}, got {', '.join(kernels) or 'none'}"
+        )
     return tuple(k for k in specialised.KERNELS if k in kernels)
 
 
@@ -99,8 +106,12 @@ def _states(chain, count: int, seed: int) -> dict[str, np.ndarray]:
     mid, half = lim.mean(axis=1), (lim[:, 1] - lim[:, 0]) / 2
     q = mid + 0.9 * half * rng.uniform(-1, 1, (count, chain.n))
     q[0] = np.clip(0.0, lim[:, 0] + 0.05 * half, lim[:, 1] - 0.05 * half)
-    return {"q": q, "qd": rng.normal(size=(count, chain.n)), "qdd": rng.normal(size=(count, chain.n)),
-            "tau": rng.normal(size=(count, chain.n))}
+    return {
+        "q": q,
+        "qd": rng.normal(size=(count, chain.n)),
+        "qdd": rng.normal(size=(count, chain.n)),
+        "tau": rng.normal(size=(count, chain.n)),
+    }
 
 
 def references(chain, kernels: list, count: int = SELFTEST_STATES, seed: int = 0) -> list[dict]:
@@ -115,16 +126,21 @@ def references(chain, kernels: list, count: int = SELFTEST_STATES, seed: int = 0
             want = getattr(chain, methods.get(k.name, k.name))(*ins)
         except ValueError:
             continue
-        tests.append({"name": k.name,
-                      "inputs": [(a, [f"{x:.17g}" for x in v.ravel()]) for a, v in zip(k.spec.inputs, ins)],
-                      "outputs": [(k.spec.outputs[0], [f"{x:.17g}" for x in np.asarray(want).ravel()])]})
+        tests.append(
+            {
+                "name": k.name,
+                "inputs": [(a, [f"{x:.17g}" for x in v.ravel()]) for a, v in zip(k.spec.inputs, ins)],
+                "outputs": [(k.spec.outputs[0], [f"{x:.17g}" for x in np.asarray(want).ravel()])],
+            }
+        )
     return tests
 
 
 def _describe(chain) -> tuple[str, str]:
     joints = ", ".join(f"{i + 1} {p.kind}" for i, p in enumerate(chain.pairs))
-    ranges = "; ".join(f"|q_{i + 1}| <= {p.theta_limit!r} (mod 2 pi)" for i, p in enumerate(chain.pairs)
-                       if p.theta_limit is not None)
+    ranges = "; ".join(
+        f"|q_{i + 1}| <= {p.theta_limit!r} (mod 2 pi)" for i, p in enumerate(chain.pairs) if p.theta_limit is not None
+    )
     return joints, ranges
 
 
@@ -141,13 +157,20 @@ def render(chain, name: str, origin: str, kernels=None, title: str | None = None
     # the title goes into C comments, CMake and pkg-config strings: plain characters only
     title = " ".join(re.sub(r"[^\w .,:()+-]", " ", title or f"{chain.n}-joint chain").split())[:80]
     origin = re.sub(r"[^\w .,:+/-]", "_", origin)[:120]
-    meta = {"title": title, "origin": origin, "joints": joints, "ranges": ranges,
-            "n": chain.n, "hash": content_hash(chain, kernels)}
+    meta = {
+        "title": title,
+        "origin": origin,
+        "joints": joints,
+        "ranges": ranges,
+        "n": chain.n,
+        "hash": content_hash(chain, kernels),
+    }
     return emitter.Emitter().render_chain(code, parts, name, meta, [dict(t, kernel=by_name[t["name"]]) for t in tests])
 
 
-def write_code(chain, out, name: str, origin: str, kernels=None, title: str | None = None,
-               force: bool = False) -> list[str]:
+def write_code(
+    chain, out, name: str, origin: str, kernels=None, title: str | None = None, force: bool = False
+) -> list[str]:
     """Write the chain's code into the folder `out` (created if need be). A file there that an
     earlier run did not write (a user's own, a symbolic link) is refused unless `force`; stale
     files of an earlier run are removed only while unedited (codegen/output.py). Returns the
@@ -188,8 +211,6 @@ def build(chain, kernels=None) -> tuple[Path, str, tuple[str, ...]] | None:
     import subprocess
     import tempfile
 
-    from . import kernels as _kernels
-
     kernels = check_kernels(kernels)
     digest = content_hash(chain, kernels)
     name = f"spec_{digest}"
@@ -199,8 +220,11 @@ def build(chain, kernels=None) -> tuple[Path, str, tuple[str, ...]] | None:
         return library, name, kernels
     cc = _compiler()
     if cc is None:
-        _warn_once("cc", "apair: AChain.specialise() found no C compiler (set CC, or install gcc); the chain "
-                         "uses the generic kernels")
+        _warn_once(
+            "cc",
+            "apair: AChain.specialise() found no C compiler (set CC, or install gcc); the chain "
+            "uses the generic kernels",
+        )
         return None
     _, emitter = _toolkit()
     code = lowered(chain, kernels)
@@ -213,12 +237,26 @@ def build(chain, kernels=None) -> tuple[Path, str, tuple[str, ...]] | None:
         work.mkdir()
         for rel, text in files.items():
             (work / rel).write_text(text)
-        cmd = [cc, "-std=c99", "-O2", "-fno-math-errno", "-fPIC", "-shared", f"-I{include}", f"{name}.c",
-               f"{name}_registry.c", "-o", library.name, "-lm"]
+        cmd = [
+            cc,
+            "-std=c99",
+            "-O2",
+            "-fno-math-errno",
+            "-fPIC",
+            "-shared",
+            f"-I{include}",
+            f"{name}.c",
+            f"{name}_registry.c",
+            "-o",
+            library.name,
+            "-lm",
+        ]
         res = subprocess.run(cmd, cwd=work, capture_output=True, text=True)
         if res.returncode != 0:
-            raise RuntimeError(f"specialise: compiling the chain's kernels failed ({' '.join(cmd)}): "
-                               f"{' '.join(res.stderr.split())[:400]}")
+            raise RuntimeError(
+                f"specialise: compiling the chain's kernels failed ({' '.join(cmd)}): "
+                f"{' '.join(res.stderr.split())[:400]}"
+            )
         try:
             os.rename(work, folder)  # atomic: another process may have won the race, which is fine
         except OSError:
@@ -236,8 +274,11 @@ def load(chain, methods, kernels=None):
     from . import kernels as _kernels
 
     if not _kernels.c_available():
-        _warn_once("native", "apair: AChain.specialise() needs the compiled C kernels (apair._native); the "
-                             "chain uses the generic kernels")
+        _warn_once(
+            "native",
+            "apair: AChain.specialise() needs the compiled C kernels (apair._native); the "
+            "chain uses the generic kernels",
+        )
         return None
     built = build(chain, kernels)
     if built is None:
@@ -250,8 +291,12 @@ def load(chain, methods, kernels=None):
     base = ctypes.addressof(ctypes.c_char.in_dll(lib, f"{name}_registry"))
     families = {f: k for k, f in _toolkit()[0].KERNELS.items()}
     fast = _kernels.native_chain(
-        chain.n, [(families.get(family, family), strict) for family, strict in methods], [],
-        [p.theta_limit if p.theta_limit is not None else float("inf") for p in chain.pairs], {}, keep=lib,
-        table=(base, names))
+        chain.n,
+        [(families.get(family, family), strict) for family, strict in methods],
+        [],
+        [p.theta_limit if p.theta_limit is not None else float("inf") for p in chain.pairs],
+        {},
+        keep=lib,
+        table=(base, names),
+    )
     return fast
-

@@ -1,4 +1,5 @@
 """Study parameters: the normalisation used by the runtime (docs/conventions.md §1)."""
+
 from __future__ import annotations
 
 import math
@@ -20,18 +21,31 @@ def to_matrix(study) -> np.ndarray:
     x, y = s[..., :4], s[..., 4:]
     n = np.sum(x * x, axis=-1)
     w, a, b, c = np.moveaxis(x, -1, 0)
-    R = np.stack([
-        np.stack([w * w + a * a - b * b - c * c, 2 * (a * b - w * c), 2 * (a * c + w * b)], -1),
-        np.stack([2 * (a * b + w * c), w * w - a * a + b * b - c * c, 2 * (b * c - w * a)], -1),
-        np.stack([2 * (a * c - w * b), 2 * (b * c + w * a), w * w - a * a - b * b + c * c], -1),
-    ], -2) / n[..., None, None]
+    R = (
+        np.stack(
+            [
+                np.stack([w * w + a * a - b * b - c * c, 2 * (a * b - w * c), 2 * (a * c + w * b)], -1),
+                np.stack([2 * (a * b + w * c), w * w - a * a + b * b - c * c, 2 * (b * c - w * a)], -1),
+                np.stack([2 * (a * c - w * b), 2 * (b * c + w * a), w * w - a * a - b * b + c * c], -1),
+            ],
+            -2,
+        )
+        / n[..., None, None]
+    )
     y0, y1, y2, y3 = np.moveaxis(y, -1, 0)
     # vector part of y x̃
-    t = 2 * np.stack([
-        -y0 * a + y1 * w - y2 * c + y3 * b,
-        -y0 * b + y1 * c + y2 * w - y3 * a,
-        -y0 * c - y1 * b + y2 * a + y3 * w,
-    ], -1) / n[..., None]
+    t = (
+        2
+        * np.stack(
+            [
+                -y0 * a + y1 * w - y2 * c + y3 * b,
+                -y0 * b + y1 * c + y2 * w - y3 * a,
+                -y0 * c - y1 * b + y2 * a + y3 * w,
+            ],
+            -1,
+        )
+        / n[..., None]
+    )
     T = np.zeros(s.shape[:-1] + (4, 4))
     T[..., :3, :3] = R
     T[..., :3, 3] = t
@@ -58,10 +72,15 @@ def _shepperd() -> tuple[np.ndarray, np.ndarray]:
 
 _SHEPPERD = _shepperd()
 # y = ½ t x̃ with t = (0, t1, t2, t3): y_i = ½ Σ L[i, a, b] t_a x_b
-_HALF_T = np.array([[[0, -1, 0, 0], [0, 0, -1, 0], [0, 0, 0, -1]],
-                    [[1, 0, 0, 0], [0, 0, 0, 1], [0, 0, -1, 0]],
-                    [[0, 0, 0, -1], [1, 0, 0, 0], [0, 1, 0, 0]],
-                    [[0, 0, 1, 0], [0, -1, 0, 0], [1, 0, 0, 0]]], float)
+_HALF_T = np.array(
+    [
+        [[0, -1, 0, 0], [0, 0, -1, 0], [0, 0, 0, -1]],
+        [[1, 0, 0, 0], [0, 0, 0, 1], [0, 0, -1, 0]],
+        [[0, 0, 0, -1], [1, 0, 0, 0], [0, 1, 0, 0]],
+        [[0, 0, 1, 0], [0, -1, 0, 0], [1, 0, 0, 0]],
+    ],
+    float,
+)
 
 
 _HALF_T_ROWS = np.ascontiguousarray(_HALF_T.transpose(1, 0, 2).reshape(3, 16))  # t ↦ Σ_a t_a L[i, a, b]
@@ -89,18 +108,24 @@ def qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton product of quaternions (..., 4), broadcasting (object arrays too)."""
     a0, a1, a2, a3 = np.moveaxis(a, -1, 0)
     b0, b1, b2, b3 = np.moveaxis(b, -1, 0)
-    return np.stack([a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
-                     a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
-                     a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
-                     a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0], -1)
+    return np.stack(
+        [
+            a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+            a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+            a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+            a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0,
+        ],
+        -1,
+    )
 
 
 def multiply(p, q) -> np.ndarray:
     """Dual-quaternion product of (..., 8) Study points (broadcasting; real or complex):
     (x1 + εy1)(x2 + εy2) = x1x2 + ε(x1y2 + y1x2), the point of T1·T2."""
     p, q = np.asarray(p), np.asarray(q)
-    return np.concatenate([qmul(p[..., :4], q[..., :4]),
-                           qmul(p[..., :4], q[..., 4:]) + qmul(p[..., 4:], q[..., :4])], -1)
+    return np.concatenate(
+        [qmul(p[..., :4], q[..., :4]), qmul(p[..., :4], q[..., 4:]) + qmul(p[..., 4:], q[..., :4])], -1
+    )
 
 
 _CONJ = np.array([1.0, -1.0, -1.0, -1.0, 1.0, -1.0, -1.0, -1.0])

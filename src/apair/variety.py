@@ -14,12 +14,13 @@ Designs whose constants are not rational (to 1e-12 relative, denominators ≤ 10
 A-pairs (whose curve is not rational), use the floating-point variant: nullspaces by SVD on
 sampled poses, reported with their residual on fresh poses.
 """
+
 from __future__ import annotations
 
 import itertools
 import math
 import random
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
@@ -51,10 +52,12 @@ class Variety(list):
 
 # ----------------------------------------------------------------------------- exact dual quaternions
 def _qmul(a, b):
-    return (a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
-            a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
-            a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
-            a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0])
+    return (
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    )
 
 
 def _smul(p, q):
@@ -123,9 +126,16 @@ def designs(chain) -> tuple[list[JointDesign], bool]:
         if exact:
             result.append(JointDesign(p.kind, rat["h"], rat["a"], rat["c"], al, ph))
         else:
-            result.append(JointDesign(p.kind, h, vals["a"], vals["c"],
-                                      (math.cos(chain.alpha[i] / 2), math.sin(chain.alpha[i] / 2)),
-                                      (math.cos(chain.theta_offset[i] / 2), math.sin(chain.theta_offset[i] / 2))))
+            result.append(
+                JointDesign(
+                    p.kind,
+                    h,
+                    vals["a"],
+                    vals["c"],
+                    (math.cos(chain.alpha[i] / 2), math.sin(chain.alpha[i] / 2)),
+                    (math.cos(chain.theta_offset[i] / 2), math.sin(chain.theta_offset[i] / 2)),
+                )
+            )
     return result, exact
 
 
@@ -300,10 +310,20 @@ def constraint_variety(chain, max_degree: int = 4, hilbert_degree: int = 6, seed
     ks = sorted(hilbert)
     second = [hilbert[k] - 2 * hilbert[k - 1] + hilbert[k - 2] for k in ks[2:]]
     degree = second[-1] if len(second) >= 2 and second[-1] == second[-2] else None
-    design = [dict(kind=j.kind, h=str(j.h), a=str(j.a), c=str(j.c), alpha_half=tuple(map(str, j.alpha)),
-                   phi_half=tuple(map(str, j.phi))) for j in js]
-    return Variety(equations, degree=degree, hilbert=dict(sorted(hilbert.items())), dims=dims, exact=True,
-                   design=design)
+    design = [
+        dict(
+            kind=j.kind,
+            h=str(j.h),
+            a=str(j.a),
+            c=str(j.c),
+            alpha_half=tuple(map(str, j.alpha)),
+            phi_half=tuple(map(str, j.phi)),
+        )
+        for j in js
+    ]
+    return Variety(
+        equations, degree=degree, hilbert=dict(sorted(hilbert.items())), dims=dims, exact=True, design=design
+    )
 
 
 def _constraint_variety_float(chain, max_degree, seed):
@@ -344,7 +364,8 @@ def _constraint_variety_float(chain, max_degree, seed):
             new = U[:, sv > 1e-7].T
         else:
             new = null
-        equations += [sp.Poly.from_dict({m: float(c) for m, c in zip(mons, row) if abs(c) > 1e-14}, *VARS)
-                      for row in new]
+        equations += [
+            sp.Poly.from_dict({m: float(c) for m, c in zip(mons, row) if abs(c) > 1e-14}, *VARS) for row in new
+        ]
         prev = (mons, null)
     return Variety(equations, degree=None, hilbert=hilbert, dims=dims, exact=False, residual=residual)

@@ -7,6 +7,7 @@ into every frame), and pair_legs for the legs. Nothing in the page retypes a for
 clearance (collisions.clearances: segment distances) is a table in θ, 0.25° apart, read by linear
 interpolation. The drawing is a small canvas renderer (no library, nothing fetched).
 """
+
 from __future__ import annotations
 
 import json
@@ -33,8 +34,12 @@ def _clearance_table(pair, lo: float, hi: float) -> dict:
     th = np.arange(lo, hi + CLEARANCE_STEP / 2, CLEARANCE_STEP)
     th = th[th <= hi]
     legs, plates = collisions.clearances(pair, th)
-    return {"theta0": float(th[0]), "step": float(CLEARANCE_STEP), "legs": np.min(legs, axis=-1).tolist(),
-            "plates": np.asarray(plates).tolist()}
+    return {
+        "theta0": float(th[0]),
+        "step": float(CLEARANCE_STEP),
+        "legs": np.min(legs, axis=-1).tolist(),
+        "plates": np.asarray(plates).tolist(),
+    }
 
 
 def chain_data(chain, workspace: int = 0, seed: int = 0) -> dict:
@@ -47,9 +52,14 @@ def chain_data(chain, workspace: int = 0, seed: int = 0) -> dict:
         lo, hi = lim[i]
         period = 2 * np.pi if p.kind == "revolute" else 4 * np.pi
         lo, hi = (max(lo, -period / 2), min(hi, period / 2))
-        j = {"kind": p.kind, "law": kernel, "params": [float(x) for x in params],
-             "dh": [float(chain.a[i]), float(chain.alpha[i]), float(chain.offset[i]), float(chain.theta_offset[i])],
-             "lower": float(lo), "upper": float(hi)}
+        j = {
+            "kind": p.kind,
+            "law": kernel,
+            "params": [float(x) for x in params],
+            "dh": [float(chain.a[i]), float(chain.alpha[i]), float(chain.offset[i]), float(chain.theta_offset[i])],
+            "lower": float(lo),
+            "upper": float(hi),
+        }
         if p.kind != "revolute":
             j["radii"] = [float(p.base_radius), float(p.platform_radius)]
             j["leg_radius"] = float(p.leg_radius)
@@ -70,9 +80,11 @@ def to_html(chain, workspace: int = 0) -> str:
     data = json.dumps(chain_data(chain, int(workspace)), separators=(",", ":"))
     page = _page_template()
     title = getattr(chain, "name", None) or "apair chain"
-    return (page.replace("/*APAIR_KERNELS*/", _kernels_js())
-                .replace("/*APAIR_CHAIN*/null", data.replace("</", "<\\/"))
-                .replace("APAIR_TITLE", escape(title)))
+    return (
+        page.replace("/*APAIR_KERNELS*/", _kernels_js())
+        .replace("/*APAIR_CHAIN*/null", data.replace("</", "<\\/"))
+        .replace("APAIR_TITLE", escape(title))
+    )
 
 
 def write(chain, path, overwrite: bool = False, workspace: int = 0):

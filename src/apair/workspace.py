@@ -21,6 +21,7 @@
 The cost is linear in the sample count: the fk kernel (about 1 µs per sample) and one np.unique
 per voxel size and offset (45 of them).
 """
+
 from __future__ import annotations
 
 import math
@@ -73,8 +74,10 @@ class Workspace:
             return f"volume {self.volume:.6g} ± {self.volume_error:.2g} m^3 (one standard uncertainty)"
         kind, unit = ("a curve", "length") if self.dimension == 1 else ("a surface", "area")
         power = "" if self.dimension == 1 else "^2"
-        return (f"{kind} (dimension {self.dimension}, no volume); estimated {unit} {self.measure:.4g} m{power} "
-                f"(from voxel crossings, a few per cent)")
+        return (
+            f"{kind} (dimension {self.dimension}, no volume); estimated {unit} {self.measure:.4g} m{power} "
+            f"(from voxel crossings, a few per cent)"
+        )
 
     def plot(self, path, overwrite: bool = False):
         """A 3D view of the points and three cross-sections through the centre (matplotlib)."""
@@ -119,8 +122,10 @@ def _run(tasks, engine, progress):
             try:
                 client = Client(engine, timeout=CONNECT_TIMEOUT)
             except (OSError, TimeoutError, ValueError) as exc:
-                raise ValueError(f"engine: cannot reach a Dask scheduler at {engine!r} within {CONNECT_TIMEOUT} "
-                                 f"({type(exc).__name__}: {exc})") from None
+                raise ValueError(
+                    f"engine: cannot reach a Dask scheduler at {engine!r} within {CONNECT_TIMEOUT} "
+                    f"({type(exc).__name__}: {exc})"
+                ) from None
         try:
             res = client.gather(client.compute(delayed))
         finally:
@@ -138,13 +143,17 @@ def _check_engine(engine) -> None:
     if isinstance(engine, str):
         if engine in LOCAL_ENGINES or "://" in engine or ":" in engine:
             return
-        raise ValueError(f"engine: expected None, one of {LOCAL_ENGINES}, a scheduler address (tcp://host:port) "
-                         f"or a dask.distributed.Client, got {engine!r}")
+        raise ValueError(
+            f"engine: expected None, one of {LOCAL_ENGINES}, a scheduler address (tcp://host:port) "
+            f"or a dask.distributed.Client, got {engine!r}"
+        )
     from dask.distributed import Client
 
     if not isinstance(engine, Client):
-        raise ValueError(f"engine: expected None, one of {LOCAL_ENGINES}, a scheduler address or a "
-                         f"dask.distributed.Client, got {engine!r}")
+        raise ValueError(
+            f"engine: expected None, one of {LOCAL_ENGINES}, a scheduler address or a "
+            f"dask.distributed.Client, got {engine!r}"
+        )
 
 
 def _voxels(points, origin, h):
@@ -203,8 +212,16 @@ def _estimate(points, origin, h0, rng):
     return float(coef[0]), float(math.sqrt(cov[0, 0] + model**2))
 
 
-def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int = 4, poses: bool = False,
-              engine=None, seed: int = 0, progress=None) -> Workspace:
+def workspace(
+    chain,
+    samples: int = 200_000,
+    resolution: int = 40,
+    rounds: int = 4,
+    poses: bool = False,
+    engine=None,
+    seed: int = 0,
+    progress=None,
+) -> Workspace:
     """Approximate the reachable workspace of the end-effector origin (see the module docstring).
 
     samples: total joint samples; resolution: voxels along the longest side of the bounding box
@@ -221,8 +238,10 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
     grid = (resolution + 4) ** 3  # bytes of the finest voxel grid (booleans, one voxel of margin a side)
     if grid > MAX_GRID_BYTES:
         top = int(MAX_GRID_BYTES ** (1 / 3)) - 4
-        raise ValueError(f"resolution: {resolution} voxels along the longest side need voxel grids of about "
-                         f"{grid / 2**30:.1f} GiB; at most {top} fit in {MAX_GRID_BYTES / 2**30:.0f} GiB")
+        raise ValueError(
+            f"resolution: {resolution} voxels along the longest side need voxel grids of about "
+            f"{grid / 2**30:.1f} GiB; at most {top} fit in {MAX_GRID_BYTES / 2**30:.0f} GiB"
+        )
     if samples * (3 + len(chain.pairs)) * 8 * (2 if poses else 1) > MAX_SAMPLE_BYTES:
         raise ValueError(f"samples: {samples} samples need more than {MAX_SAMPLE_BYTES / 2**30:.0f} GiB to keep")
     if samples < 1000 * rounds:
@@ -247,8 +266,9 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
             on_edge = _member(key, edge)
             centres = qs[on_edge] if on_edge.any() else qs
             step = sigma / (1 + r)
-            tasks = [(chain, lo, hi, (seed, r, k), c, centres if k % 2 else None, step, poses)
-                     for k, c in enumerate(counts)]
+            tasks = [
+                (chain, lo, hi, (seed, r, k), c, centres if k % 2 else None, step, poses) for k, c in enumerate(counts)
+            ]
         tick = (lambda k, _n, done=done: progress(done + k, total)) if progress else None
         parts += _run(tasks, engine, tick)
         done += len(counts)
@@ -265,10 +285,19 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
     dimension = _dimension(chain, qs, side)
     edge = _boundary(pts, origin, h0)
     if dimension < 3:
-        return Workspace(points=pts, q=qs, boundary=origin + (edge + 0.5) * h0, voxel=h0, volume=None,
-                         volume_error=None, poses=np.concatenate([p["poses"] for p in parts]) if poses else None,
-                         history=history, chain_name=getattr(chain, "name", ""), dimension=dimension,
-                         measure=_measure(chain, pts, qs, origin, h0, dimension))
+        return Workspace(
+            points=pts,
+            q=qs,
+            boundary=origin + (edge + 0.5) * h0,
+            voxel=h0,
+            volume=None,
+            volume_error=None,
+            poses=np.concatenate([p["poses"] for p in parts]) if poses else None,
+            history=history,
+            chain_name=getattr(chain, "name", ""),
+            dimension=dimension,
+            measure=_measure(chain, pts, qs, origin, h0, dimension),
+        )
     rng = np.random.default_rng((seed, 99))
     volume, fit_err = _estimate(pts, origin, h0, rng)
     coarse, _ = _estimate(pts, origin, COARSER * h0, np.random.default_rng((seed, 99)))
@@ -279,9 +308,17 @@ def workspace(chain, samples: int = 200_000, resolution: int = 40, rounds: int =
     else:
         volume += missing
     error = math.sqrt(fit_err**2 + missing**2 + (volume - missing - coarse) ** 2)
-    return Workspace(points=pts, q=qs, boundary=origin + (edge + 0.5) * h0, voxel=h0, volume=volume,
-                     volume_error=error, poses=np.concatenate([p["poses"] for p in parts]) if poses else None,
-                     history=history, chain_name=getattr(chain, "name", ""))
+    return Workspace(
+        points=pts,
+        q=qs,
+        boundary=origin + (edge + 0.5) * h0,
+        voxel=h0,
+        volume=volume,
+        volume_error=error,
+        poses=np.concatenate([p["poses"] for p in parts]) if poses else None,
+        history=history,
+        chain_name=getattr(chain, "name", ""),
+    )
 
 
 def _dimension(chain, qs, side: float, probes: int = 256) -> int:
@@ -297,6 +334,7 @@ def _measure(chain, pts, qs, origin, h, dimension: int) -> float:
     |n|₁/h² per unit area, so each occupied voxel contributes h/|t|₁ (h²/|n|₁) with the tangent
     (normal) of one sample in it, from the Jacobian there; measured at the voxel sizes LEVELS and
     extrapolated linearly to size 0."""
+
     def at(size):
         idx = np.floor((pts - origin) / size).astype(np.int64)
         _, first = np.unique(idx, axis=0, return_index=True)
@@ -342,11 +380,12 @@ def _member(keys, table):
     inv = inv.ravel()
     in_table = np.zeros(inv.max() + 1, dtype=bool)
     in_table[inv[: len(table)]] = True
-    return in_table[inv[len(table):]]
+    return in_table[inv[len(table) :]]
 
 
 def text_progress(stream=None, width: int = 40):
     """A progress bar for the command line (on stderr by default): callable(done, total)."""
+
     def show(done, total):
         out = stream or sys.stderr
         filled = int(width * done / max(total, 1))
@@ -354,4 +393,5 @@ def text_progress(stream=None, width: int = 40):
         if done >= total:
             out.write("\n")
         out.flush()
+
     return show

@@ -7,6 +7,7 @@ library takes only the kernels it calls), the hand-written solvers copied from s
 CMakeLists.txt and apair.pc.in to build and install it. The header's content hash covers every C
 source, so it identifies the library; the manifest records it with the sources' digest.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -51,8 +52,10 @@ def copies(template: TemplateSource = TEMPLATES) -> dict[str, str]:
     for origin in HAND_WRITTEN:
         path = ROOT / origin
         if not path.is_file():
-            raise FileNotFoundError(f"{origin}: the C library's hand-written sources are read from the source "
-                                    f"tree ({ROOT}), which this installation does not have")
+            raise FileNotFoundError(
+                f"{origin}: the C library's hand-written sources are read from the source "
+                f"tree ({ROOT}), which this installation does not have"
+            )
         text = path.read_text()
         out[Path(origin).name] = banner.render(origin=origin, hash=content_hash([banner_src, text])) + text
     return out
@@ -68,8 +71,12 @@ def render(kernels: list[Lowered], template: TemplateSource = TEMPLATES) -> Libr
 
     registry_t, registry_src = template("registry.c.j2")
     files["c/apair_registry.c"] = registry_t.render(
-        kernels=sorted(kernels, key=lambda k: k.name), prefix=PREFIX, sources=sources, inv_sizes=inv_sizes,
-        hash=content_hash([registry_src] + [fingerprints[k.name] for k in kernels]))
+        kernels=sorted(kernels, key=lambda k: k.name),
+        prefix=PREFIX,
+        sources=sources,
+        inv_sizes=inv_sizes,
+        hash=content_hash([registry_src] + [fingerprints[k.name] for k in kernels]),
+    )
 
     called = sorted({c.kernel for k in kernels for c in k.calls})
     for name in called:
@@ -79,27 +86,43 @@ def render(kernels: list[Lowered], template: TemplateSource = TEMPLATES) -> Libr
     internal = sorted(set(called) | {k.name for k in wide})
     internal_t, internal_src = template("apair_internal.h.j2")
     files["c/apair_internal.h"] = internal_t.render(
-        kernels=[by_name[c] for c in called], wide=wide, prefix=PREFIX,
+        kernels=[by_name[c] for c in called],
+        wide=wide,
+        prefix=PREFIX,
         sources=sorted({by_name[c].spec.source for c in internal}) or ["no derivation (no internal kernel)"],
-        hash=content_hash([internal_src] + [fingerprints[c] for c in internal]))
+        hash=content_hash([internal_src] + [fingerprints[c] for c in internal]),
+    )
 
     src_t, src_src = template("kernels.c.j2")
     for k in kernels:
         c_hash = content_hash([src_src, fingerprints[k.name]] + [fingerprints[c.kernel] for c in k.calls])
-        files[f"c/{k.name}.c"] = src_t.render(kernels=[k], source=k.spec.source, hash=c_hash, prefix=PREFIX,
-                                              by_name=by_name, called=called, inv_sizes=inv_sizes)
+        files[f"c/{k.name}.c"] = src_t.render(
+            kernels=[k],
+            source=k.spec.source,
+            hash=c_hash,
+            prefix=PREFIX,
+            by_name=by_name,
+            called=called,
+            inv_sizes=inv_sizes,
+        )
     hand_written = copies(template)
     files.update({f"c/{name}": text for name, text in hand_written.items()})
 
     c_sources = sorted(["apair_registry.c", *hand_written] + [f"{k.name}.c" for k in kernels])
     header_t, header_src = template("apair.h.j2")
-    header_hash = content_hash([header_src, VERSION] + [fingerprints[k.name] for k in kernels]
-                               + [files[f"c/{c}"] for c in c_sources] + [files["c/apair_internal.h"]])
-    files["c/apair.h"] = header_t.render(kernels=kernels, hash=header_hash, sources=sources, prefix=PREFIX,
-                                         version=VERSION, inv_sizes=inv_sizes)
+    header_hash = content_hash(
+        [header_src, VERSION]
+        + [fingerprints[k.name] for k in kernels]
+        + [files[f"c/{c}"] for c in c_sources]
+        + [files["c/apair_internal.h"]]
+    )
+    files["c/apair.h"] = header_t.render(
+        kernels=kernels, hash=header_hash, sources=sources, prefix=PREFIX, version=VERSION, inv_sizes=inv_sizes
+    )
     for name in ("CMakeLists.txt", "apair.pc.in"):
         t, src = template(f"{name}.j2")
-        files[f"c/{name}"] = t.render(sources=sources, c_sources=c_sources, version=VERSION,
-                                      hash=content_hash([src, VERSION] + c_sources))
+        files[f"c/{name}"] = t.render(
+            sources=sources, c_sources=c_sources, version=VERSION, hash=content_hash([src, VERSION] + c_sources)
+        )
     compiled = {rel[2:]: text for rel, text in files.items() if rel.endswith((".c", ".h"))}
     return Library(files, header_hash, sources_hash(compiled), {k.name: ops_per_item(k, by_name) for k in kernels})

@@ -1,4 +1,5 @@
 """The C backend's expression printer: C99 with libm only."""
+
 from __future__ import annotations
 
 from sympy.printing.c import C99CodePrinter

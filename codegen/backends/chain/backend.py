@@ -6,6 +6,7 @@ name.py and manifest.json; and the registry in apair.h's form by which AChain.sp
 Its kernels have no design inputs (nothing to hoist); a composite kernel calls its parts (the
 kernels it is built from) one block of items at a time.
 """
+
 from __future__ import annotations
 
 import json
@@ -43,8 +44,10 @@ class ChainKernel:
 
 
 def _part_call(i: int, c: LoweredCall, parts: dict[str, Lowered]) -> PartCall:
-    block = [f"{arg} + j * {a.size}" if arg[:1] == "r" and arg[1:].isdigit() else f"{arg} + (k0 + j) * {a.size}"
-             for arg, a in c.args]
+    block = [
+        f"{arg} + j * {a.size}" if arg[:1] == "r" and arg[1:].isdigit() else f"{arg} + (k0 + j) * {a.size}"
+        for arg, a in c.args
+    ]
     return PartCall(i, parts[c.kernel], c.out.size, [arg for arg, _ in c.args], block, bool(c.results))
 
 
@@ -54,8 +57,14 @@ def chain_kernel(k: Lowered, parts: dict[str, Lowered]) -> ChainKernel:
     return ChainKernel(k, [_part_call(i, c, parts) for i, c in enumerate(k.calls)], results + k.c.assignments)
 
 
-def render(kernels: list[Lowered], parts: dict[str, Lowered], name: str, meta: dict, tests: list[dict],
-           template: TemplateSource = TEMPLATES) -> dict[str, str]:
+def render(
+    kernels: list[Lowered],
+    parts: dict[str, Lowered],
+    name: str,
+    meta: dict,
+    tests: list[dict],
+    template: TemplateSource = TEMPLATES,
+) -> dict[str, str]:
     """The chain's files: name.h, name.c, name.py, name_selftest.c, CMakeLists.txt, name.pc.in and
     manifest.json. `parts`: the kernels that `kernels` call, by name; `meta`: title, origin (the
     chain file), joints, ranges, n, hash; `tests`: per kernel checked {kernel (Lowered), inputs:
@@ -65,20 +74,37 @@ def render(kernels: list[Lowered], parts: dict[str, Lowered], name: str, meta: d
             raise ValueError(f"{k.name}: a specialised kernel has no design inputs, and its parts are given")
     ctx = dict(meta, name=name, kernels=kernels, version=VERSION, guard=f"{name.upper()}_H")
     files = {}
-    for source, out in (("chain.h.j2", f"{name}.h"), ("chain_CMakeLists.txt.j2", "CMakeLists.txt"),
-                        ("chain.pc.in.j2", f"{name}.pc.in")):
+    for source, out in (
+        ("chain.h.j2", f"{name}.h"),
+        ("chain_CMakeLists.txt.j2", "CMakeLists.txt"),
+        ("chain.pc.in.j2", f"{name}.pc.in"),
+    ):
         files[out] = template(source)[0].render(**ctx)
     views = [chain_kernel(k, parts) for k in kernels]
     files[f"{name}.c"] = template("chain.c.j2")[0].render(**dict(ctx, kernels=views))
     count = len(tests[0]["inputs"][0][1]) // tests[0]["inputs"][0][0].size if tests else 0
     files[f"{name}_selftest.c"] = template("chain_selftest.c.j2")[0].render(**ctx, count=count, tests=tests)
-    files[f"{name}.py"] = numpy_module(list(parts.values()) + kernels, meta["origin"], meta["hash"],
-                                       constants=[("N", meta["n"]), ("CONTENT_HASH", repr(meta["hash"]))],
-                                       template=template)
-    manifest = {"content_hash": meta["hash"], "prefix": name, "n": meta["n"], "origin": meta["origin"],
-                "kernels": {k.name: {"inputs": [{"name": a.name, "shape": list(a.shape)} for a in k.spec.inputs],
-                                     "outputs": [{"name": a.name, "shape": list(a.shape)} for a in k.spec.outputs],
-                                     "ops": k.ops} for k in kernels}}
+    files[f"{name}.py"] = numpy_module(
+        list(parts.values()) + kernels,
+        meta["origin"],
+        meta["hash"],
+        constants=[("N", meta["n"]), ("CONTENT_HASH", repr(meta["hash"]))],
+        template=template,
+    )
+    manifest = {
+        "content_hash": meta["hash"],
+        "prefix": name,
+        "n": meta["n"],
+        "origin": meta["origin"],
+        "kernels": {
+            k.name: {
+                "inputs": [{"name": a.name, "shape": list(a.shape)} for a in k.spec.inputs],
+                "outputs": [{"name": a.name, "shape": list(a.shape)} for a in k.spec.outputs],
+                "ops": k.ops,
+            }
+            for k in kernels
+        },
+    }
     files["manifest.json"] = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
     return files
 

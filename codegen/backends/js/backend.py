@@ -1,6 +1,7 @@
 """The JavaScript backend: the kernels the browser viewer (apair view) evaluates, in
 js/apair_kernels.js: the pair laws, one joint's transform (the page multiplies them into every
 frame) and the leg end points."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -20,5 +21,10 @@ def render(kernels: list[Lowered], template: TemplateSource = TEMPLATES) -> dict
     if sorted(k.name for k in web) != sorted(WEB_KERNELS):
         return {}
     t, src = template("kernels.js.j2")
-    return {"js/apair_kernels.js": t.render(kernels=web, sources=sorted({k.spec.source for k in web}),
-                                            hash=content_hash([src] + [k.fingerprint for k in web]))}
+    return {
+        "js/apair_kernels.js": t.render(
+            kernels=web,
+            sources=sorted({k.spec.source for k in web}),
+            hash=content_hash([src] + [k.fingerprint for k in web]),
+        )
+    }

@@ -1,4 +1,5 @@
 """The JavaScript backend's expression printer: ES5 Math, with the C printer's literals."""
+
 from __future__ import annotations
 
 from sympy.printing.jscode import JavascriptCodePrinter

@@ -1,5 +1,6 @@
 """The NumPy backend: one module of vectorised kernels per derivation (numpy/<derivation>.py), and
 numpy/__init__.py with every kernel by name. Each kernel broadcasts over leading batch axes."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -11,8 +12,13 @@ from ...templating import Templates, TemplateSource
 TEMPLATES = Templates(Path(__file__).parent / "templates")
 
 
-def module(kernels: list[Lowered], source: str, hash: str, constants: list[tuple[str, object]] | None = None,
-           template: TemplateSource = TEMPLATES) -> str:
+def module(
+    kernels: list[Lowered],
+    source: str,
+    hash: str,
+    constants: list[tuple[str, object]] | None = None,
+    template: TemplateSource = TEMPLATES,
+) -> str:
     """The text of one module of kernels (`constants`: module-level (name, value) assignments)."""
     context = {"kernels": kernels, "source": source, "hash": hash}
     if constants is not None:
@@ -25,13 +31,18 @@ def module_hash(kernels: list[Lowered], template: TemplateSource = TEMPLATES) ->
     return content_hash([template("kernels.py.j2")[1]] + [k.fingerprint for k in kernels])
 
 
-def render(lowered: dict[str, list[Lowered]], library_hash: str,
-           template: TemplateSource = TEMPLATES) -> dict[str, str]:
+def render(
+    lowered: dict[str, list[Lowered]], library_hash: str, template: TemplateSource = TEMPLATES
+) -> dict[str, str]:
     """{path under generated/: text} of the modules of `lowered` ({derivation module stem: its
     kernels}) and their index (stamped with the C library's content hash)."""
-    files = {f"numpy/{stem}.py": module(ks, ks[0].spec.source, module_hash(ks, template), template=template)
-             for stem, ks in lowered.items()}
+    files = {
+        f"numpy/{stem}.py": module(ks, ks[0].spec.source, module_hash(ks, template), template=template)
+        for stem, ks in lowered.items()
+    }
     files["numpy/__init__.py"] = template("numpy_init.py.j2")[0].render(
-        modules=sorted(lowered), kernels=sorted((k.name, stem) for stem, ks in lowered.items() for k in ks),
-        hash=library_hash)
+        modules=sorted(lowered),
+        kernels=sorted((k.name, stem) for stem, ks in lowered.items() for k in ks),
+        hash=library_hash,
+    )
     return files

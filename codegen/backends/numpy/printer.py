@@ -1,4 +1,5 @@
 """The NumPy backend's expression printer: fully qualified numpy calls, vectorised over a batch."""
+
 from __future__ import annotations
 
 from sympy.printing.numpy import NumPyPrinter as _SympyNumPyPrinter

@@ -1,5 +1,6 @@
 """The polynomials backend: a derived polynomial set as plain text, LaTeX, and JSON that loads back
 into sympy (polynomials/<name>.{txt,tex,json})."""
+
 from __future__ import annotations
 
 import json
@@ -77,16 +78,18 @@ def rows(ps: PolynomialSet) -> tuple[list[dict], dict[str, str]]:
     for e in ps.entries:
         for s in sorted((e.expr.free_symbols | (e.rhs.free_symbols if e.rhs is not None else set())), key=str):
             symbols[str(s)] = _assumption(s)
-        out.append({
-            "label": e.label,
-            "note": e.note,
-            "text": collected(e.expr, e.variables, sp.sstr) + ("" if e.rhs is None else f" = {sp.sstr(e.rhs)}"),
-            "latex": collected(e.expr, e.variables, sp.latex) + ("" if e.rhs is None else f" = {sp.latex(e.rhs)}"),
-            "lhs": sp.sstr(e.expr),
-            "rhs": None if e.rhs is None else sp.sstr(e.rhs),
-            "variables": [str(v) for v in e.variables],
-            **describe(e),
-        })
+        out.append(
+            {
+                "label": e.label,
+                "note": e.note,
+                "text": collected(e.expr, e.variables, sp.sstr) + ("" if e.rhs is None else f" = {sp.sstr(e.rhs)}"),
+                "latex": collected(e.expr, e.variables, sp.latex) + ("" if e.rhs is None else f" = {sp.latex(e.rhs)}"),
+                "lhs": sp.sstr(e.expr),
+                "rhs": None if e.rhs is None else sp.sstr(e.rhs),
+                "variables": [str(v) for v in e.variables],
+                **describe(e),
+            }
+        )
     return out, symbols
 
 
@@ -98,10 +101,15 @@ def render_polynomial_set(ps: PolynomialSet, hasher: Callable[[list[str]], str] 
     digest = hasher([txt_src, tex_src, json.dumps(entries, sort_keys=True)])
     ctx = {"ps": ps, "rows": entries, "hash": digest}
     data = {
-        "name": ps.name, "title": ps.title, "source": ps.source, "description": ps.description,
-        "content_hash": digest, "symbols": dict(sorted(symbols.items())),
-        "entries": [{k: r[k] for k in ("label", "note", "lhs", "rhs", "variables", "degree", "terms")}
-                    for r in entries],
+        "name": ps.name,
+        "title": ps.title,
+        "source": ps.source,
+        "description": ps.description,
+        "content_hash": digest,
+        "symbols": dict(sorted(symbols.items())),
+        "entries": [
+            {k: r[k] for k in ("label", "note", "lhs", "rhs", "variables", "degree", "terms")} for r in entries
+        ],
     }
     return {
         f"polynomials/{ps.name}.txt": txt.render(**ctx),

@@ -14,6 +14,7 @@ solution of a pose, each verified, by the cheapest exact method that fits the ch
 Nothing here imports `apair.chain` (the chain delegates to this package, never the other way)
 but the `make ik-counts` script `homotopy.counts`, which draws a random chain of every pattern.
 """
+
 from __future__ import annotations
 
 from .local import LocalSolution, distance, ik_local

@@ -32,6 +32,7 @@ rank-deficient, a singular leading coefficient, spurious roots not where they be
 that could be real not converging, or doubled: singular poses, designs with a double root) None,
 and the caller tracks the homotopy.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -162,8 +163,9 @@ def _split(k: int) -> tuple[tuple[int, int], int, tuple[int, int]]:
     return (k + 1, k + 2), k + 3, tuple(sorted(set(range(1, 7)) - {k, k + 1, k + 2, k + 3}))
 
 
-def angles(tau: np.ndarray, vecs: np.ndarray, P: np.ndarray, L: np.ndarray, dh: np.ndarray, k: int,
-           T: np.ndarray) -> np.ndarray:
+def angles(
+    tau: np.ndarray, vecs: np.ndarray, P: np.ndarray, L: np.ndarray, dh: np.ndarray, k: int, T: np.ndarray
+) -> np.ndarray:
     """θ (m, 6) from m eigenvalues τ (m,) and their monomial vectors (m, 12): step 4."""
     (m1, m2), e, (r1, r2) = _split(k)
     m = len(tau)
@@ -176,7 +178,7 @@ def angles(tau: np.ndarray, vecs: np.ndarray, P: np.ndarray, L: np.ndarray, dh: 
     psi[:, m1 - 1] = SIGMA[1] + 2 * np.arctan(x1)
     psi[:, m2 - 1] = SIGMA[2] + 2 * np.arctan(x2)
     C, S = np.cos(theta_k / 2), np.sin(theta_k / 2)
-    basis = np.stack([C ** i * S ** j for i, j in [(i, 0) for i in range(5)] + [(i, 1) for i in range(4)]], 1)
+    basis = np.stack([C**i * S**j for i, j in [(i, 0) for i in range(5)] + [(i, 1) for i in range(4)]], 1)
     cs = cos_sin(psi[:, [m1 - 1, m2 - 1]])
     X = np.einsum("ki,kj->kij", cs[:, 0], cs[:, 1]).reshape(m, 9)
     XR = np.ones((m, 9), complex)  # (1, c, s)_{r1} ⊗ (1, c, s)_{r2}, the rest by least squares
@@ -196,7 +198,7 @@ def angles(tau: np.ndarray, vecs: np.ndarray, P: np.ndarray, L: np.ndarray, dh: 
     R = _rotations(psi, dh[:, 1])
     v = np.zeros((m, 3), complex)
     v[:, 0] = 1
-    transpose = lambda i, x: np.einsum("kji,kj->ki", R[:, i - 1], x)  # noqa: E731  R_iᵀ x
+    transpose = lambda i, x: np.einsum("kji,kj->ki", R[:, i - 1], x)
     for i in range(k + 4, 7):
         v = transpose(i, v)
     v = v @ T[:3, :3].T

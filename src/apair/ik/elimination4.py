@@ -54,6 +54,7 @@ Chains of 5 and 6 joints are solved by the eliminations of apair.ik.elimination6
 apair.ik.elimination1a5r or by parameter homotopy (apair.ik.homotopy), and `ik_local`
 (apair.ik.local) is a Levenberg-Marquardt search from seeds in C for any chain.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -107,8 +108,10 @@ class Elimination:
         self.rng = np.random.default_rng(seed)
         deltas = self.rng.uniform(-np.pi, np.pi, n)
         self.joints, self.pre = chain_joints(chain, scale, deltas, reverse)
-        self.theta_map = (np.array([2.0 if j.kind == "revolute" else 4.0 for j in self.joints]),
-                          np.array([j.delta for j in self.joints]))
+        self.theta_map = (
+            np.array([2.0 if j.kind == "revolute" else 4.0 for j in self.joints]),
+            np.array([j.delta for j in self.joints]),
+        )
         j1 = self.joints[0]
         if n >= 2:  # Z(u_1) = K_1⁻¹·P̃_1(u_1)·W·K_2⁻¹ = Σ u_1^m Zmap[m] W
             right = right_matrix(self.joints[1].Kinv)
@@ -209,8 +212,13 @@ class Elimination:
         if not np.iscomplexobj(Ws):
             Z = np.einsum("km,kma->ka", u1[:, None] ** np.arange(Zc.shape[1]), Zc[rows])
             u2 = self.joints[1].parameters_of(Z)  # (R, 1 or 2), each tested
-            ok = np.stack([relres_many(np.swapaxes(curve_minors(self.joints[1].P, Z), 1, 2), u2[:, j]) <= ROOT_RTOL
-                           for j in range(u2.shape[1])], 1)
+            ok = np.stack(
+                [
+                    relres_many(np.swapaxes(curve_minors(self.joints[1].P, Z), 1, 2), u2[:, j]) <= ROOT_RTOL
+                    for j in range(u2.shape[1])
+                ],
+                1,
+            )
             one &= ok.any(axis=1)
             for r, x, ys, oks in zip(rows[one], u1[one], u2[one], ok[one]):
                 out[r] = [np.array([x, y]) for y, good in zip(ys, oks) if good]
@@ -239,7 +247,7 @@ class Elimination:
         variable u_1), and each u_1 gets the common roots u_2 of all minors. Two R-pairs on one
         axis have a curve of solutions (the resultant vanishes identically): Degenerate."""
         P2 = self.joints[1].P
-        a, b = np.array([(a, b) for i, a in enumerate(INSIDE) for b in INSIDE[i + 1:]]).T
+        a, b = np.array([(a, b) for i, a in enumerate(INSIDE) for b in INSIDE[i + 1 :]]).T
         minors = (Zc[:, None, a] * P2[None, :, b] - Zc[:, None, b] * P2[None, :, a]).transpose(2, 0, 1)
         f, g = (np.tensordot(self.rng.standard_normal(len(minors)), minors, 1) for _ in range(2))
         out = []
@@ -277,12 +285,21 @@ class Elimination:
         the roots and the pair eliminated (None for a singular pencil's regular part)."""
         native = native_in_use()
         # the first pair that the loop below would not skip for a row constant in u_3, in C
-        a, b = next((ab for ab in self._tries(True) if min(self.shapes[ab[0] + 1][0], self.shapes[ab[1] + 1][0]) >= 2),
-                    (0, 0))
+        a, b = next(
+            (ab for ab in self._tries(True) if min(self.shapes[ab[0] + 1][0], self.shapes[ab[1] + 1][0]) >= 2), (0, 0)
+        )
         if native is not None and a < b and not np.iscomplexobj(C):
             du, dv = self.deflatable[a, b]
-            out = native.ik4_pencil(C, self.combinations[a + 1], self._factor_array(a + 1), self.combinations[b + 1],
-                                    self._factor_array(b + 1), LEAD_COND, int(du) + 2 * int(dv), DEFLATE_TOL)
+            out = native.ik4_pencil(
+                C,
+                self.combinations[a + 1],
+                self._factor_array(a + 1),
+                self.combinations[b + 1],
+                self._factor_array(b + 1),
+                LEAD_COND,
+                int(du) + 2 * int(dv),
+                DEFLATE_TOL,
+            )
             if out is not None:
                 f, g, M = out
                 return eigenvalues(M), (f, g)
@@ -332,8 +349,9 @@ class Elimination:
         native = native_in_use()
         if native is not None:  # in C (apair_ik4_screen), the same steps
             N = pair[0].shape[1] + pair[1].shape[1] - 2
-            status, u4, W, rel, two, two_ok, W2, rel2 = native.ik4_screen(u3s, C, pair[0], pair[1], self.Q,
-                                                                           PROBE[:N], _SCREEN_TOL)
+            status, u4, W, rel, two, two_ok, W2, rel2 = native.ik4_screen(
+                u3s, C, pair[0], pair[1], self.Q, PROBE[:N], _SCREEN_TOL
+            )
             vandermonde = status <= 2
             rows = np.flatnonzero(~vandermonde)
             known, real = status[rows] == 3, two_ok[rows].astype(bool)
@@ -500,4 +518,3 @@ def _quadric_forms(pts: np.ndarray) -> np.ndarray:
     Q = np.zeros((len(null), d, d))
     Q[:, i, j] = null
     return (Q + np.swapaxes(Q, 1, 2)) / 2
-

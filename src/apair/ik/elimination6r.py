@@ -26,6 +26,7 @@ Where Q loses rank (axes 1 and 2 parallel, say) the chain is read from its end
 not where they belong, a root that does not converge, one lost or doubled (designs with fewer
 than 16 solutions, singular poses) — returns None, and the caller tracks the homotopy instead.
 """
+
 from __future__ import annotations
 
 import math
@@ -128,8 +129,15 @@ def eliminate(dh: np.ndarray, T: np.ndarray) -> np.ndarray | None:
     return angles(x3[keep], vecs[:, keep].T, P, L, dh, T)
 
 
-def angles(x3: np.ndarray, vecs: np.ndarray, P: np.ndarray, L: np.ndarray, dh: np.ndarray, T: np.ndarray,
-           engine: str | None = None) -> np.ndarray:
+def angles(
+    x3: np.ndarray,
+    vecs: np.ndarray,
+    P: np.ndarray,
+    L: np.ndarray,
+    dh: np.ndarray,
+    T: np.ndarray,
+    engine: str | None = None,
+) -> np.ndarray:
     """θ (k, 6) from k eigenpairs (x3 (k,), vecs (k, 24)) of the companion matrix: step 4 of the
     module. In C (apair_ik6r_angles) where installed, else NumPy."""
     native = native_in_use() if engine in (None, "c") else None
@@ -171,7 +179,7 @@ def reversed_chain(dh: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarra
     Rz(−ψ_k)·Tz(−c_k)·Tx(−a_{k−1})·Rx(−α_{k−1}) (a_0 = α_0 = 0). Where the first two axes are
     parallel (Q rank-deficient) the last two usually are not."""
     a, alpha, c = dh[:, 0], dh[:, 1], dh[:, 2]
-    prev = lambda x: np.concatenate([[0.0], x[:-1]])  # noqa: E731  x_{k-1}, with x_0 = 0
+    prev = lambda x: np.concatenate([[0.0], x[:-1]])
     rev = np.stack([-prev(a), -prev(alpha), -c, np.zeros(6)], 1)[::-1]
     ca, sa = math.cos(alpha[5]), math.sin(alpha[5])
     base = np.array([[1, 0, 0, a[5]], [0, ca, -sa, 0], [0, sa, ca, 0], [0, 0, 0, 1]])  # Tx(a6)·Rx(α6)
@@ -198,8 +206,9 @@ def solve(problem, T: np.ndarray) -> np.ndarray | None:
     return None if theta is None else verified(problem, theta, pose, COUNT)
 
 
-def verified(problem, theta: np.ndarray, pose: np.ndarray, count: int, must: np.ndarray | None = None
-             ) -> np.ndarray | None:
+def verified(
+    problem, theta: np.ndarray, pose: np.ndarray, count: int, must: np.ndarray | None = None
+) -> np.ndarray | None:
     """The `count` candidates θ (count, 6) of an elimination after Newton on the homotopy system
     at the pose, or None unless every candidate in `must` (default: all) converged and the
     converged ones are distinct (then the set is complete where `count` is the pattern's generic

@@ -3,11 +3,12 @@ A_i(u) = P_i(u)·K_i, P_i(u) a polynomial curve in its shifted parameter u in th
 (rotations about and translations along z), K_i = Tx(a_i)·Rx(α_i) constant; the chain's joints
 forward or reversed (`chain_joints`), and the Study products as 8×8 matrices.
 """
+
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 
@@ -27,7 +28,7 @@ def _mobius(coeffs: np.ndarray, tau: float) -> np.ndarray:
     return out
 
 
-@lru_cache(maxsize=None)
+@cache
 def _quartic() -> np.ndarray:
     """(5, 8, 2): the coefficient of u^m h^k in component j of the sinusoidal pair's Study point,
     read from the derived set `apair_motion` (entries rational_x0 … rational_y3)."""
@@ -131,8 +132,9 @@ def chain_joints(chain, scale: float, deltas, reverse: bool):
         return [_make_joint(kinds[i], deltas[i], P[i], K[i]) for i in range(n)], None
     one = np.zeros(8)
     one[0] = 1.0
-    joints = [_make_joint(kinds[i], deltas[i], conjugate(P[i]), conjugate(K[i - 1]) if i else one)
-              for i in reversed(range(n))]
+    joints = [
+        _make_joint(kinds[i], deltas[i], conjugate(P[i]), conjugate(K[i - 1]) if i else one) for i in reversed(range(n))
+    ]
     return joints, K[n - 1]
 
 
@@ -172,4 +174,3 @@ def curve_minors(P: np.ndarray, Z: np.ndarray) -> np.ndarray:
 def evaluate(coeffs: np.ndarray, u: np.ndarray) -> np.ndarray:
     """(R, ...): the polynomial curve of coefficients (D+1, ...) at the parameters u (R,)."""
     return np.einsum("m...,rm->r...", coeffs, np.asarray(u)[:, None] ** np.arange(len(coeffs)))
-

@@ -2,6 +2,7 @@
 and Jacobian kernels (the fallback where the elimination degenerates, the nearest reachable pose
 of `distance`), and `ik_local`, the same search in C from the user's seeds.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -26,8 +27,15 @@ def on_continuum(chain, q: np.ndarray, T: np.ndarray, tol: float) -> bool:
     return bool(err[0] <= tol and np.abs(moved[0] - q).max() > 1e-3)
 
 
-def local_search(chain, T: np.ndarray, seeds: int = 64, iterations: int = 60, seed: int = SEED,
-                 bounds: np.ndarray | None = None, start: np.ndarray | None = None) -> np.ndarray:
+def local_search(
+    chain,
+    T: np.ndarray,
+    seeds: int = 64,
+    iterations: int = 60,
+    seed: int = SEED,
+    bounds: np.ndarray | None = None,
+    start: np.ndarray | None = None,
+) -> np.ndarray:
     """Levenberg-Marquardt on the pose error from `seeds` joint vectors drawn uniformly (in
     `bounds` (n, 2), default each joint's period), all at once over the batched fk and Jacobian
     kernels (or from the rows of `start`); returns the end points, kept inside the bounds. Not
@@ -121,8 +129,17 @@ def ik_local(chain, T, q0, tol: float = 1e-10, max_iter: int = 100) -> LocalSolu
     pair = np.zeros((n, 2))
     for i, p in enumerate(chain.pairs):
         params = p.law_kernel[1]
-        pair[i, :len(params)] = params
-    q, res, conv = native.ik_local(kind, pair, np.ascontiguousarray(chain._dh, float),
-                                   np.ascontiguousarray(lim[:, 0]), np.ascontiguousarray(lim[:, 1]), scale_of(chain),
-                                   Tb, qb, tol, max_iter)
+        pair[i, : len(params)] = params
+    q, res, conv = native.ik_local(
+        kind,
+        pair,
+        np.ascontiguousarray(chain._dh, float),
+        np.ascontiguousarray(lim[:, 0]),
+        np.ascontiguousarray(lim[:, 1]),
+        scale_of(chain),
+        Tb,
+        qb,
+        tol,
+        max_iter,
+    )
     return LocalSolution(q.reshape(shape + (n,)), res.reshape(shape), conv.reshape(shape).astype(bool))

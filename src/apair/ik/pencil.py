@@ -20,9 +20,10 @@
   every use checks that the divisions are still exact. The result is linearised by column degrees
   (Kailath's column companion form): Σ δ states, its leading column coefficients inverted.
 """
+
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import scipy.linalg
@@ -80,7 +81,7 @@ def common_roots_many(polys: np.ndarray, rng: np.random.Generator) -> list:
         if len(rows) == 0:
             continue
         A = np.zeros((len(rows), d, d), comb.dtype)
-        A[:, 0, :] = -comb[rows, d - 1::-1] / comb[rows, d, None]  # np.roots' companion form
+        A[:, 0, :] = -comb[rows, d - 1 :: -1] / comb[rows, d, None]  # np.roots' companion form
         A[:, np.arange(1, d), np.arange(d - 1)] = 1
         roots = np.linalg.eigvals(A)  # (rows, d)
         pw = roots[:, :, None] ** np.arange(polys.shape[2])
@@ -97,7 +98,7 @@ def shifted(polys: np.ndarray, m: int) -> np.ndarray:
     R, k, d = polys.shape
     out = np.zeros((R, m + 1, k, d + m), polys.dtype)
     for s in range(m + 1):
-        out[:, s, :, s: s + d] = polys
+        out[:, s, :, s : s + d] = polys
     return out.reshape(R, (m + 1) * k, d + m)
 
 
@@ -149,7 +150,7 @@ def isotropic_quotient(p: np.ndarray, factors: tuple[int, int]) -> np.ndarray:
     return _isotropic_division(p.shape[0] - 1, a) @ p @ _isotropic_division(p.shape[1] - 1, b).T
 
 
-@lru_cache(maxsize=None)
+@cache
 def _isotropic_division(d: int, m: int) -> np.ndarray:
     """The matrix ((d − 2m + 1) × (d + 1)) of p ↦ the quotient of p (degree d) by (1 + u²)^m: the
     recurrence quot_k = p_k − quot_{k−2}, m times."""
@@ -162,7 +163,7 @@ def _isotropic_division(d: int, m: int) -> np.ndarray:
     return M
 
 
-@lru_cache(maxsize=None)
+@cache
 def _isotropic_product(d: int) -> np.ndarray:
     """The matrix ((d + 3) × (d + 1)) of q ↦ (1 + u²)·q for q of degree d."""
     return np.eye(d + 3, d + 1) + np.eye(d + 3, d + 1, -2)
@@ -185,7 +186,7 @@ def deflate(f: np.ndarray, g: np.ndarray, tol: float = None) -> np.ndarray | Non
     k = dg - df
     A = np.zeros((dg + 1, k + 1), complex)  # g(i, ·) = f(i, ·)·h: convolution by f(i, ·)
     for j in range(k + 1):
-        A[j: j + df + 1, j] = fi
+        A[j : j + df + 1, j] = fi
     if not (np.abs(fi).max() > 0 and np.abs(gi).max() > 0):
         return None
     h = np.linalg.lstsq(A, gi, rcond=None)[0]
@@ -195,10 +196,10 @@ def deflate(f: np.ndarray, g: np.ndarray, tol: float = None) -> np.ndarray | Non
     if rows < 4:  # the quotient would be constant in u
         return None
     out = np.zeros((rows, dg + 1))
-    out[:g.shape[0]] = g
+    out[: g.shape[0]] = g
     for i, part in enumerate((h.real, h.imag)):  # − a·f, a = Re h + u Im h
         for j, c in enumerate(part):
-            out[i: i + f.shape[0], j: j + df + 1] -= c * f
+            out[i : i + f.shape[0], j : j + df + 1] -= c * f
     return _isotropic_division(rows - 1, 1) @ out
 
 
@@ -208,7 +209,7 @@ def bezout_of(f: tuple, g: tuple) -> int:
     return (f[0] - 1) * (g[1] - 1) + (f[1] - 1) * (g[0] - 1)
 
 
-@lru_cache(maxsize=None)
+@cache
 def product_map(m: int, k: int) -> np.ndarray:
     """(m·k, m + k − 1): the coefficients of a product of two polynomials from their outer
     product (m, k), flattened."""
@@ -226,9 +227,9 @@ def sylvester_at(f: np.ndarray, g: np.ndarray, u: np.ndarray) -> np.ndarray:
     df, dg = f.shape[1] - 1, g.shape[1] - 1
     S = np.zeros((len(u), df + dg, df + dg), fu.dtype)
     for r in range(dg):
-        S[:, r, r: r + df + 1] = fu
+        S[:, r, r : r + df + 1] = fu
     for r in range(df):
-        S[:, dg + r, r: r + dg + 1] = gu
+        S[:, dg + r, r : r + dg + 1] = gu
     return S
 
 
@@ -238,7 +239,7 @@ PROBE = np.random.default_rng(SEED).standard_normal(64)  # right-hand side of th
 def null_vectors(S: np.ndarray) -> np.ndarray:
     """(R, N): unit null vectors of the singular matrices S (R, N, N) by two steps of inverse
     iteration from a fixed vector; NaN rows where LU meets an exact zero pivot."""
-    x = np.broadcast_to(PROBE[:S.shape[1], None], (len(S), S.shape[1], 1))
+    x = np.broadcast_to(PROBE[: S.shape[1], None], (len(S), S.shape[1], 1))
     try:
         for _ in range(2):
             x = np.linalg.solve(S, x)
@@ -275,12 +276,17 @@ def polished(f: np.ndarray, g: np.ndarray, u: np.ndarray, v: np.ndarray, steps: 
     i, j = np.arange(f.shape[0]), np.arange(f.shape[1])
     k, m = np.arange(g.shape[0]), np.arange(g.shape[1])
     for _ in range(steps):
+
         def at(P, a, b):  # value, ∂u, ∂v
             pa, pb = u[:, None] ** a, v[:, None] ** b
             da = a * np.concatenate([np.zeros((len(u), 1)), pa[:, :-1]], 1)
             db = b * np.concatenate([np.zeros((len(v), 1)), pb[:, :-1]], 1)
-            return (np.einsum("ra,ab,rb->r", pa, P, pb), np.einsum("ra,ab,rb->r", da, P, pb),
-                    np.einsum("ra,ab,rb->r", pa, P, db))
+            return (
+                np.einsum("ra,ab,rb->r", pa, P, pb),
+                np.einsum("ra,ab,rb->r", da, P, pb),
+                np.einsum("ra,ab,rb->r", pa, P, db),
+            )
+
         F, Fu, Fv = at(f, i, j)
         G, Gu, Gv = at(g, k, m)
         det = Fu * Gv - Fv * Gu
@@ -289,7 +295,7 @@ def polished(f: np.ndarray, g: np.ndarray, u: np.ndarray, v: np.ndarray, steps: 
     return u, v
 
 
-@lru_cache(maxsize=None)
+@cache
 def _linearisation(degs: tuple):
     """Index structure of the row linearisation for row degrees `degs`: the shift equations
     z_{i,k+1} = u z_{i,k} (rows, columns of z_{i,k}) and each row's block (offset, degree)."""
@@ -310,11 +316,11 @@ def hidden_variable(f: np.ndarray, g: np.ndarray, rng, singular_ok: bool = True)
     rows = []  # (coefficients in u (d+1, N)) per row
     for r in range(dg):
         row = np.zeros((f.shape[0], N), dtype)
-        row[:, r: r + df + 1] = f
+        row[:, r : r + df + 1] = f
         rows.append(row)
     for r in range(df):
         row = np.zeros((g.shape[0], N), dtype)
-        row[:, r: r + dg + 1] = g
+        row[:, r : r + dg + 1] = g
         rows.append(row)
     degs = tuple(len(r) - 1 for r in rows)
     if min(degs) < 1:
@@ -326,14 +332,14 @@ def hidden_variable(f: np.ndarray, g: np.ndarray, rng, singular_ok: bool = True)
     A[shift_rows, shift_cols + 1] = 1.0
     B[shift_rows, shift_cols] = 1.0
     for (lo, d), row in zip(blocks, rows):  # the last N rows: Σ_i row_i(u)ᵀ w_i = 0
-        A[size - N:, lo: lo + d] = -row[:d].T
-        B[size - N:, lo + d - 1] = row[d]
+        A[size - N :, lo : lo + d] = -row[:d].T
+        B[size - N :, lo + d - 1] = row[d]
     lead_cols = [lo + d - 1 for lo, d in blocks]
-    lead = B[size - N:, lead_cols]  # B is I plus this block, permuted
+    lead = B[size - N :, lead_cols]  # B is I plus this block, permuted
     if np.linalg.cond(lead, 1) < LEAD_COND:  # then the pencil is regular (det has its full degree)
         M = np.zeros((size, size), dtype)  # B⁻¹A: the shift rows as they are, lead⁻¹ times the last N rows
         M[shift_cols, shift_cols + 1] = 1.0
-        M[lead_cols] = np.linalg.solve(lead, A[size - N:])
+        M[lead_cols] = np.linalg.solve(lead, A[size - N :])
         return eigenvalues(M)
     z = np.exp(2j * np.pi * rng.random())  # a random point on the unit circle
     sv = np.linalg.svd(np.stack([z ** np.arange(len(r)) @ r for r in rows]), compute_uv=False)
@@ -412,13 +418,13 @@ class Linearisation:
                     num = np.convolve(np.eye(degree + 1)[p], N[:, j])
                     q, r = poly.polydiv(np.pad(num, (0, max(0, len(div) - len(num)))), div)
                     quo.append(q)
-                    rem.append(np.pad(r, (0, max(0, len(div) - 1 - len(r))))[:max(len(div) - 1, 1)])
+                    rem.append(np.pad(r, (0, max(0, len(div) - 1 - len(r))))[: max(len(div) - 1, 1)])
             width = max(len(q) for q in quo)
             # the final degree: the highest power with a coefficient in the map
             Q = np.array([np.pad(q, (0, width - len(q))) for q in quo])
             nz = np.flatnonzero(np.abs(Q).max(axis=0) > 0)
             d = int(nz[-1]) if len(nz) else 0
-            blocks.append(Q[:, :d + 1])
+            blocks.append(Q[:, : d + 1])
             rems.append(np.array(rem))
             deg.append(d)
         self.degrees = np.array(deg)
@@ -439,19 +445,19 @@ class Linearisation:
         return (self.degree * self.n - self.size) // 2
 
     @staticmethod
-    def plain(degree: int, n: int) -> "Linearisation":
+    def plain(degree: int, n: int) -> Linearisation:
         """No columns divided: the block companion form ((degree · n) states)."""
         return Linearisation(degree, n, [(np.eye(n)[None, c], 0) for c in range(n)])
 
     @staticmethod
-    def of(M: np.ndarray, limit: int) -> "Linearisation":
+    def of(M: np.ndarray, limit: int) -> Linearisation:
         """The operations found on M (D + 1, n, n), at most `limit` divisions."""
         D, n = M.shape[0] - 1, M.shape[1]
         cols = [M[:, :, c].copy() for c in range(n)]  # the current columns' coefficients (deg + 1, n)
         ops = [(np.eye(n)[None, c], 0) for c in range(n)]
         ipow = 1j ** np.arange(2 * D + 2)
         for _ in range(limit):
-            Mi = np.stack([ipow[:len(c)] @ c for c in cols], axis=1)
+            Mi = np.stack([ipow[: len(c)] @ c for c in cols], axis=1)
             W = _real_null(Mi)
             if W.shape[1] == 0:
                 break
@@ -471,7 +477,7 @@ class Linearisation:
                 Nc = ops[c][0]
                 for _ in range(E - ops[c][1]):
                     Nc = np.array([np.convolve(_ONE_PLUS, Nc[:, j]) for j in range(n)]).T
-                N[:len(Nc)] += v[c] * Nc
+                N[: len(Nc)] += v[c] * Nc
             cols[pivot], ops[pivot] = quo, (N, E + 1)
         return Linearisation(D, n, ops)
 

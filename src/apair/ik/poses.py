@@ -2,6 +2,7 @@
 periods and the angles' ranges, and the verification of candidates: Gauss-Newton refinement
 against the pose, weighted by the chain's length scale, with duplicates merged (`refine`).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -146,4 +147,3 @@ def pose_error(chain, q: np.ndarray, T: np.ndarray):
     S = T[:3, :3] @ np.swapaxes(F[:, :3, :3], 1, 2)  # Σ_k f_k × t_k = vee(T Fᵀ − F Tᵀ) (columns f_k, t_k)
     dw = 0.5 * np.stack([S[:, 2, 1] - S[:, 1, 2], S[:, 0, 2] - S[:, 2, 0], S[:, 1, 0] - S[:, 0, 1]], 1)
     return np.concatenate([dp, dw], 1), np.abs(F - T).max(axis=(1, 2))
-

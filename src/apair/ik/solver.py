@@ -6,6 +6,7 @@ method by the chain's shape. 1 to 4 joints: the elimination by kinematic mapping
 homotopy from the design's start system (apair.ik.homotopy). Every real candidate is verified and
 refined by apair.ik.poses.refine.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -52,8 +53,10 @@ class Solver:
             raise ValueError(f"chain: inverse kinematics covers chains of 1 to 6 pairs, this one has {n}")
         for i, p in enumerate(chain.pairs):
             if p.kind == "general":
-                raise ValueError(f"pairs[{i}]: a general A-pair's motion is not rational; inverse kinematics "
-                                 "needs sinusoidal A-pairs or R-pairs")
+                raise ValueError(
+                    f"pairs[{i}]: a general A-pair's motion is not rational; inverse kinematics "
+                    "needs sinusoidal A-pairs or R-pairs"
+                )
         self.chain = chain
         self.scale = scale_of(chain)
         self.seed = seed
@@ -93,8 +96,9 @@ class Solver:
         q, err = refine(self.chain, local_search(self.chain, Tm), Tm, tol)
         if len(q) and on_continuum(self.chain, q[0], Tm, tol):
             why = f" ({degenerate[0]})" if degenerate else ""
-            raise ValueError(f"T: the solutions at this pose are not isolated{why}: they form a curve (e.g. "
-                             "two R-pairs on one axis)")
+            raise ValueError(
+                f"T: the solutions at this pose are not isolated{why}: they form a curve (e.g. two R-pairs on one axis)"
+            )
         certified = len(q) == 0 and not degenerate  # the elimination's "none" stands
         return Solution(q, err, 0, None, certified=certified, method="local search")
 
@@ -134,8 +138,10 @@ class Solver:
         q, _ = refine(self.chain, local_search(self.chain, Tm, start=q), Tm, tol)
         for k in np.flatnonzero(jacobian_rank(self.chain, q) < self.chain.n):
             if on_continuum(self.chain, q[k], Tm, tol):
-                raise ValueError("T: the solutions at this pose are not isolated: they form a curve (e.g. a wrist "
-                                 "singularity, two R-pair axes in line)")
+                raise ValueError(
+                    "T: the solutions at this pose are not isolated: they form a curve (e.g. a wrist "
+                    "singularity, two R-pair axes in line)"
+                )
 
 
 def _dedupe_complex(cands, tol: float = 1e-6) -> list:
@@ -144,4 +150,3 @@ def _dedupe_complex(cands, tol: float = 1e-6) -> list:
         if not any(np.max(np.abs(c - o) / (1 + np.abs(o))) < tol for o in out):
             out.append(c)
     return out
-

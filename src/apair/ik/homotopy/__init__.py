@@ -41,6 +41,7 @@ reaches all of it:
   where paths lose digits) goes unnoticed. A pose's answer is complete when, in addition, every
   path ended (finite, or diverging to infinity) at a distinct point.
 """
+
 from __future__ import annotations
 
 from .endpoints import Endpoints, solve
@@ -82,8 +83,44 @@ from .tracker import (
     unit_gamma,
 )
 
-__all__ = ["DIVERGED", "FAILED", "LOOSE", "OK", "REAL", "RETRIES", "SAME", "SINGULAR", "TOO_LONG", "TRACK", "VIRTUAL",
-           "VIRTUAL_ZERO", "WIDE_POSE", "WIDE_START", "Endpoints", "Index", "Problem", "StartSystem", "canonical",
-           "generic_count", "law", "linear_pose", "newton", "own", "own_rows", "prepare", "random_pose", "real_angles",
-           "scale_of", "segment", "solve", "start_system", "stored_counts", "system", "target_of", "track",
-           "track_numpy", "track_system", "unit_gamma"]
+__all__ = [
+    "DIVERGED",
+    "FAILED",
+    "LOOSE",
+    "OK",
+    "REAL",
+    "RETRIES",
+    "SAME",
+    "SINGULAR",
+    "TOO_LONG",
+    "TRACK",
+    "VIRTUAL",
+    "VIRTUAL_ZERO",
+    "WIDE_POSE",
+    "WIDE_START",
+    "Endpoints",
+    "Index",
+    "Problem",
+    "StartSystem",
+    "canonical",
+    "generic_count",
+    "law",
+    "linear_pose",
+    "newton",
+    "own",
+    "own_rows",
+    "prepare",
+    "random_pose",
+    "real_angles",
+    "scale_of",
+    "segment",
+    "solve",
+    "start_system",
+    "stored_counts",
+    "system",
+    "target_of",
+    "track",
+    "track_numpy",
+    "track_system",
+    "unit_gamma",
+]

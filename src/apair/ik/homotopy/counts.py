@@ -21,6 +21,7 @@ is there to catch one. Agreeing runs are weaker than the trace test: solutions f
 complex, where paths lose digits, can be missed by all runs alike (before the tracker took the
 residual in extended precision there, seven counts were one to eight short of round numbers).
 """
+
 from __future__ import annotations
 
 import itertools
@@ -59,15 +60,20 @@ def design(pattern: str, seed: int = 0):
     n = len(pattern)
     pairs = [APair.revolute() if c == "R" else APair(rng.uniform(0.2, 0.4), rng.uniform(0.15, 0.35)) for c in pattern]
     alpha = rng.uniform(0.3, 1.3, n) * rng.choice([-1, 1], n)
-    return AChain(pairs, a=rng.uniform(0.3, 1.0, n), alpha=alpha, offset=rng.uniform(-0.5, 0.5, n),
-                  theta_offset=rng.uniform(-np.pi, np.pi, n))
+    return AChain(
+        pairs,
+        a=rng.uniform(0.3, 1.0, n),
+        alpha=alpha,
+        offset=rng.uniform(-0.5, 0.5, n),
+        theta_offset=rng.uniform(-np.pi, np.pi, n),
+    )
 
 
 def reachable_pose(problem: Problem, rng) -> np.ndarray:
     """A generic complex pose (t, q) on the chain's own image: a random complex joint vector of the
     chain, the virtual joints at 0."""
     theta = np.zeros(problem.n, complex)
-    theta[:problem.joints] = rng.uniform(-np.pi, np.pi, problem.joints) + 0.3j * rng.standard_normal(problem.joints)
+    theta[: problem.joints] = rng.uniform(-np.pi, np.pi, problem.joints) + 0.3j * rng.standard_normal(problem.joints)
     A, b = linear_pose(problem, theta)
     p, *_ = np.linalg.lstsq(A, -b, rcond=None)
     _, sv, Vh = np.linalg.svd(A)
@@ -94,15 +100,17 @@ def count(pattern: str, seed: int = 0, progress=None, trace_upto: int = 0) -> di
         for _ in range(RETRIES + 1):
             end, status = segment(problem, start.p0, p1, start.solutions, rng)
             for e in end[status == OK]:
-                if np.all(np.abs(np.exp(1j * e[problem.joints:]) - 1) <= VIRTUAL_ZERO):
+                if np.all(np.abs(np.exp(1j * e[problem.joints :]) - 1) <= VIRTUAL_ZERO):
                     found.add(e)
             if np.all(status != FAILED):
                 break
         found = len(found.rows)
     how = f"monodromy: {len(start.runs)} runs found {start.runs}"
     if traced:
-        how += (f"; trace test {'passed' if start.certified else 'FAILED'} (deviation {start.trace:.0e}, "
-                f"{start.witnesses} witnesses)")
+        how += (
+            f"; trace test {'passed' if start.certified else 'FAILED'} (deviation {start.trace:.0e}, "
+            f"{start.witnesses} witnesses)"
+        )
         certified = start.certified
     else:
         # a second design: it has at most the generic count, so a run that finds more shows the
@@ -113,10 +121,16 @@ def count(pattern: str, seed: int = 0, progress=None, trace_upto: int = 0) -> di
         certified = start.runs_agree and second <= start.count
     if pattern in KNOWN:
         how += f"; known: {KNOWN[pattern]}"
-    return {"pattern": pattern, "joints": len(pattern), "count": found, "start_count": start.count,
-            "certified": bool(certified and KNOWN.get(pattern, found) == found), "traced": traced,
-            "how": how,
-            "seconds": round(time.perf_counter() - t0, 1)}
+    return {
+        "pattern": pattern,
+        "joints": len(pattern),
+        "count": found,
+        "start_count": start.count,
+        "certified": bool(certified and KNOWN.get(pattern, found) == found),
+        "traced": traced,
+        "how": how,
+        "seconds": round(time.perf_counter() - t0, 1),
+    }
 
 
 def main(argv=None) -> int:
@@ -138,8 +152,10 @@ def main(argv=None) -> int:
     known = patterns(args.max_n)
     for p in args.only or ():
         if p not in known:
-            parser.error(f"--only: {p!r} is not a stored pattern of 1 to {args.max_n} joints (A and R, the first "
-                         f"of a pattern and its reverse)")
+            parser.error(
+                f"--only: {p!r} is not a stored pattern of 1 to {args.max_n} joints (A and R, the first "
+                f"of a pattern and its reverse)"
+            )
     old = {}
     if args.update or args.only:
         if not args.out.is_file():

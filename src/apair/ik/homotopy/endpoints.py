@@ -1,6 +1,7 @@
 """One pose: the start system tracked to it, the endpoints pooled and the solutions that failed or
 jumped paths left missing looked for with new γ (`solve`).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -93,6 +94,11 @@ def solve(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 0) ->
     keep = own_rows(problem, theta)
     accounted = len(found.rows) + diverged + infinite
     complete = start.certified and accounted == start.count
-    return Endpoints(theta[keep, :problem.joints], complete, start.count, max(start.count - accounted, 0), diverged + infinite,
-                     np.array(found.loose, bool)[keep])
-
+    return Endpoints(
+        theta[keep, : problem.joints],
+        complete,
+        start.count,
+        max(start.count - accounted, 0),
+        diverged + infinite,
+        np.array(found.loose, bool)[keep],
+    )

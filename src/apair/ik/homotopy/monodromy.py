@@ -2,6 +2,7 @@
 that carry the known solutions to a permutation of them and add the new ones (`monodromy`); the
 paths of a loop's segment that lost their way are tracked again with new γ (`segment`).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -43,7 +44,7 @@ def _seed_solution(problem: Problem, rng):
         M, rhs = A, -b
         p, *_ = np.linalg.lstsq(M, rhs, rcond=None)
         _, sv, Vh = np.linalg.svd(M)
-        null = Vh[len(sv[sv > 1e-10 * sv[0]]):].conj().T
+        null = Vh[len(sv[sv > 1e-10 * sv[0]]) :].conj().T
         p = p + null @ (rng.standard_normal(null.shape[1]) + 1j * rng.standard_normal(null.shape[1]))
         F, J, _ = system(problem, theta, p, np.zeros(7, complex))
         H, Hv = F, J
@@ -51,15 +52,25 @@ def _seed_solution(problem: Problem, rng):
             continue
         sv = np.linalg.svd(Hv, compute_uv=False)
         if sv[-1] < 1e-8 * sv[0]:
-            raise ValueError("chain: the inverse kinematics has no isolated solutions at a generic pose (the "
-                             "solutions form curves: e.g. two R-pairs on one axis, or a joint that cannot move the "
-                             "end frame)")
+            raise ValueError(
+                "chain: the inverse kinematics has no isolated solutions at a generic pose (the "
+                "solutions form curves: e.g. two R-pairs on one axis, or a joint that cannot move the "
+                "end frame)"
+            )
         return theta, p
     raise RuntimeError("homotopy: no regular starting solution found")
 
 
-def monodromy(problem: Problem, rng: np.random.Generator, stable: int = STABLE,
-              max_loops: int = MAX_LOOPS, progress=None, p0=None, known=None, target: int = 0):
+def monodromy(
+    problem: Problem,
+    rng: np.random.Generator,
+    stable: int = STABLE,
+    max_loops: int = MAX_LOOPS,
+    progress=None,
+    p0=None,
+    known=None,
+    target: int = 0,
+):
     """All solutions at one generic pose by monodromy loops: (p0, solutions (k, n), loops). Ends
     after `stable` loops in a row found nothing new, or once `target` (> 0) solutions are known."""
     index = Index(problem)

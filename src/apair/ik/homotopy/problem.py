@@ -3,6 +3,7 @@ joints, the virtual ones last, lengths in units of the chain's scale), its equat
 the generated kernels (`law`, `system`), the pose coordinates (t, q), and when two complex angle
 vectors are one solution (`canonical`, `Index`; the chain's own among the six-joint ones: `own`).
 """
+
 from __future__ import annotations
 
 import json
@@ -42,11 +43,13 @@ class Problem:
         return len(self.kind)
 
     @staticmethod
-    def of(chain) -> "Problem":
+    def of(chain) -> Problem:
         for i, p in enumerate(chain.pairs):
             if p.kind == "general":
-                raise ValueError(f"pairs[{i}]: a general A-pair's motion is not rational; inverse kinematics "
-                                 "needs sinusoidal A-pairs or R-pairs")
+                raise ValueError(
+                    f"pairs[{i}]: a general A-pair's motion is not rational; inverse kinematics "
+                    "needs sinusoidal A-pairs or R-pairs"
+                )
         s = scale_of(chain)
         kind = [0 if p.kind == "revolute" else 1 for p in chain.pairs]
         pair = [[p.amplitude / s, 0.0] for p in chain.pairs]
@@ -59,15 +62,21 @@ class Problem:
 
     def key(self) -> str:
         """What the start system depends on, as text (floats exactly)."""
-        return json.dumps({"kind": self.kind.tolist(), "pair": [float(x).hex() for x in self.pair[:, 0]],
-                           "dh": [[float(x).hex() for x in row] for row in self.dh], "joints": self.joints})
+        return json.dumps(
+            {
+                "kind": self.kind.tolist(),
+                "pair": [float(x).hex() for x in self.pair[:, 0]],
+                "dh": [[float(x).hex() for x in row] for row in self.dh],
+                "joints": self.joints,
+            }
+        )
 
     def pose(self, T: np.ndarray) -> np.ndarray:
         """The pose (4 × 4) the 6 tracked joints must reach for the chain to reach T (4 × 4): T in
         units of scale, times the virtual joints at 0."""
         Ts = np.array(T, float)
         Ts[:3, 3] /= self.scale
-        for a, alpha, c, phi in self.dh[self.joints:]:
+        for a, alpha, c, phi in self.dh[self.joints :]:
             Ts = Ts @ _dh(0.0, a, alpha, c, phi)
         return Ts
 
@@ -90,8 +99,13 @@ def _dh(theta, a, alpha, c, phi) -> np.ndarray:
 # The virtual joints that complete a chain of n < 6 joints (a, α, c, φ in units of the chain's
 # scale): fixed, of generic geometry (no zero, parallel or perpendicular axes), so that the start
 # systems and counts are reproducible.
-VIRTUAL = ((0.61, 1.13, 0.37, 0.0), (0.83, -0.71, 0.29, 0.0), (0.47, 1.37, -0.53, 0.0), (0.71, -1.21, 0.41, 0.0),
-           (0.53, 0.89, -0.31, 0.0))
+VIRTUAL = (
+    (0.61, 1.13, 0.37, 0.0),
+    (0.83, -0.71, 0.29, 0.0),
+    (0.47, 1.37, -0.53, 0.0),
+    (0.71, -1.21, 0.41, 0.0),
+    (0.53, 0.89, -0.31, 0.0),
+)
 
 
 def law(problem: Problem, theta: np.ndarray):
@@ -183,8 +197,10 @@ class Index:
             for j in self.buckets.get(k, ()):
                 d = theta - self.rows[j]
                 re = np.abs(d.real) % self.period
-                if np.all(np.maximum(np.minimum(re, self.period - re), np.abs(d.imag))
-                          <= (LOOSE if loose or self.loose[j] else SAME)):
+                if np.all(
+                    np.maximum(np.minimum(re, self.period - re), np.abs(d.imag))
+                    <= (LOOSE if loose or self.loose[j] else SAME)
+                ):
                     if self.loose[j] and not loose:
                         self.buckets[k].remove(j)
                         self.buckets.setdefault(key, []).append(j)
@@ -204,13 +220,13 @@ def random_pose(rng: np.random.Generator) -> np.ndarray:
 
 def own_rows(problem: Problem, theta: np.ndarray) -> np.ndarray:
     """(k,) bool: which 6-joint solutions θ (k, 6) are the chain's own (the virtual joints at 0)."""
-    v = np.exp(1j * theta[:, problem.joints:])  # the virtual joints are R-pairs
+    v = np.exp(1j * theta[:, problem.joints :])  # the virtual joints are R-pairs
     return np.all(np.abs(v - 1) <= VIRTUAL_ZERO, axis=1)
 
 
 def own(problem: Problem, theta: np.ndarray) -> np.ndarray:
     """The chain's own solutions (k', n) among the 6-joint solutions θ (k, 6)."""
-    return theta[own_rows(problem, theta), :problem.joints]
+    return theta[own_rows(problem, theta), : problem.joints]
 
 
 def real_angles(problem: Problem, theta: np.ndarray, tol: float = REAL) -> np.ndarray:

@@ -3,6 +3,7 @@
 design's content hash (`start_system`), and the patterns' generic counts it is certified against
 (`stored_counts`, `generic_count`).
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -58,35 +59,63 @@ class StartSystem:
     def how(self) -> str:
         """How `certified` was decided, in words."""
         if self.traced:
-            return (f"the trace test {'passed' if self.certified else 'failed'} (deviation {self.trace:.1e}, "
-                    f"{self.witnesses} witnesses)")
+            return (
+                f"the trace test {'passed' if self.certified else 'failed'} (deviation {self.trace:.1e}, "
+                f"{self.witnesses} witnesses)"
+            )
         if self.generic and self.count == self.generic:
             return f"it has the pattern's generic count {self.generic} (apair show ik_counts), which no design exceeds"
         if self.generic and self.count > self.generic:
-            return (f"it has more solutions than the pattern's generic count {self.generic}: a solution is "
-                    "counted twice (or the stored count is short)")
-        return ("two monodromy runs found it" if self.certified else
-                "a path was lost in the check loops" if self.runs_agree else "the monodromy runs disagree") + \
-            (f" (the pattern's generic count is {self.generic})" if self.generic else "")
+            return (
+                f"it has more solutions than the pattern's generic count {self.generic}: a solution is "
+                "counted twice (or the stored count is short)"
+            )
+        return (
+            "two monodromy runs found it"
+            if self.certified
+            else "a path was lost in the check loops"
+            if self.runs_agree
+            else "the monodromy runs disagree"
+        ) + (f" (the pattern's generic count is {self.generic})" if self.generic else "")
 
     def save(self, path: Path) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
         with open(tmp, "wb") as f:
-            np.savez(f, format=FORMAT, problem_key=self.problem_key, p0=self.p0, solutions=self.solutions, loops=self.loops, runs=np.array(self.runs),
-                     certified=self.certified, seconds=self.seconds, trace=self.trace, witnesses=self.witnesses,
-                     generic=self.generic)
+            np.savez(
+                f,
+                format=FORMAT,
+                problem_key=self.problem_key,
+                p0=self.p0,
+                solutions=self.solutions,
+                loops=self.loops,
+                runs=np.array(self.runs),
+                certified=self.certified,
+                seconds=self.seconds,
+                trace=self.trace,
+                witnesses=self.witnesses,
+                generic=self.generic,
+            )
         os.replace(tmp, path)
 
     @staticmethod
-    def load(path: Path, key: str) -> "StartSystem | None":
+    def load(path: Path, key: str) -> StartSystem | None:
         try:
             with np.load(path, allow_pickle=False) as z:
                 if int(z["format"]) != FORMAT or str(z["problem_key"]) != key:
                     return None
-                return StartSystem(key, z["p0"], z["solutions"],
-                                   int(z["loops"]), [int(x) for x in z["runs"]], bool(z["certified"]),
-                                   float(z["seconds"]), float(z["trace"]), int(z["witnesses"]), int(z["generic"]))
+                return StartSystem(
+                    key,
+                    z["p0"],
+                    z["solutions"],
+                    int(z["loops"]),
+                    [int(x) for x in z["runs"]],
+                    bool(z["certified"]),
+                    float(z["seconds"]),
+                    float(z["trace"]),
+                    int(z["witnesses"]),
+                    int(z["generic"]),
+                )
         except (OSError, ValueError, KeyError):
             return None
 
@@ -102,8 +131,7 @@ def prepare(problem: Problem, seed: int = 0, progress=None, runs: int = 4, gener
     rng = np.random.default_rng([seed, problem.n, problem.joints, 17])
     p0, sols, loops = monodromy(problem, rng, progress=progress, target=generic)
     counts = [len(sols)]
-    while (len(counts) < runs and sum(c == len(sols) for c in counts) < 2
-           and not 0 < generic <= len(sols)):
+    while len(counts) < runs and sum(c == len(sols) for c in counts) < 2 and not 0 < generic <= len(sols):
         q0, other, more = monodromy(problem, rng, progress=progress, target=generic)
         loops += more
         counts.append(len(other))
@@ -143,7 +171,7 @@ def generic_count(problem: Problem) -> int:
     """The certified generic number of solutions of the problem's pattern from the stored counts,
     or 0. For 6 joints the pattern or its reverse; for fewer, the start set with the virtual joints,
     stored for the pattern as written."""
-    pattern = "".join("A" if k else "R" for k in problem.kind[:problem.joints])
+    pattern = "".join("A" if k else "R" for k in problem.kind[: problem.joints])
     rows = stored_counts()
     names = {pattern, pattern[::-1]} if problem.joints == 6 else {pattern}
     return next((int(r["start_count"]) for r in rows if r["pattern"] in names and r["certified"]), 0)
@@ -179,4 +207,3 @@ def start_system(problem: Problem, progress=None, refresh: bool = False, certify
     except OSError:
         pass  # a read-only cache: the start system is used without being kept
     return start
-

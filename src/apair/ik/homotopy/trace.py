@@ -26,6 +26,7 @@ A test that passes is strong numerical evidence, not a proof. A test that fails 
 is incomplete, the start set or the witnesses (so the witness monodromy goes on and the test is
 repeated); a path that cannot be tracked leaves no verdict, which counts as a failure.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -84,8 +85,9 @@ class Slice:
         pb = self.problem
         theta, lam = x[:, :6], x[:, 6]
         P = self.p[None, :] + lam[:, None] * self.w[None, :]
-        F, dF, dFl = kernels.call("ik_system6", pairs_of(law(pb, theta)), pairs_of(P),
-                                  pairs_of(np.broadcast_to(self.w, P.shape)), pb.dh)
+        F, dF, dFl = kernels.call(
+            "ik_system6", pairs_of(law(pb, theta)), pairs_of(P), pairs_of(np.broadcast_to(self.w, P.shape)), pb.dh
+        )
         z, k = coordinates(pb, theta)
         a = self.ell[0][None, :] + s[:, None] * self.dell[0][None, :]
         b = self.ell[1][None, :] + s[:, None] * self.dell[1][None, :]
@@ -111,8 +113,16 @@ class Slice:
                 raise RuntimeError("engine: the compiled C kernels are not installed")
             return track_system(self, gamma, start, 6)
         pb = self.problem
-        args = (pb.kind, pb.pair, pb.dh, *(np.ascontiguousarray(v, complex) for v in (self.p, self.w, self.ell, self.dell)),
-                complex(self.t0), complex(self.dt), bool(self.times_lambda), complex(gamma))
+        args = (
+            pb.kind,
+            pb.pair,
+            pb.dh,
+            *(np.ascontiguousarray(v, complex) for v in (self.p, self.w, self.ell, self.dell)),
+            complex(self.t0),
+            complex(self.dt),
+            bool(self.times_lambda),
+            complex(gamma),
+        )
         return threaded(lambda share: native.ik_track_slice(*args, share), start)
 
     def track(self, start: np.ndarray, rng) -> tuple[np.ndarray, np.ndarray]:
@@ -142,8 +152,7 @@ def _crandn(rng, *shape) -> np.ndarray:
     return (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)) / math.sqrt(2)
 
 
-def witness_points(problem: Problem, start: StartSystem, rng, progress=None, known=None,
-                   quiet: int = QUIET):
+def witness_points(problem: Problem, start: StartSystem, rng, progress=None, known=None, quiet: int = QUIET):
     """(w, ℓ, W, S): a random pose direction w, a random ℓ, the points W (k, 7) of C ∩ {ℓ = 1} and
     the start set S (m, 6), by monodromy from one point of C (a start solution tracked to λ*, with
     ℓ scaled through it), until `quiet` loops in a row find nothing new. Two kinds of loop: through
@@ -158,11 +167,11 @@ def witness_points(problem: Problem, start: StartSystem, rng, progress=None, kno
         w, S = random_pose(rng), start.solutions
         # from a start solution near the real ones: ℓ is scaled through its image, and ℓ with small
         # coefficients would put the witnesses far out in the complex, where paths fail
-        near = np.argsort(np.abs(S.imag).max(axis=1))[:max(4, len(S) // 8)]
+        near = np.argsort(np.abs(S.imag).max(axis=1))[: max(4, len(S) // 8)]
         for _ in range(20):
             lam = complex(_crandn(rng, 1)[0])
             j = int(rng.choice(near))
-            end, status = segment(problem, start.p0, start.p0 + lam * w, S[j:j + 1], rng)
+            end, status = segment(problem, start.p0, start.p0 + lam * w, S[j : j + 1], rng)
             if status[0] == OK:
                 break
         else:
@@ -189,8 +198,10 @@ def witness_points(problem: Problem, start: StartSystem, rng, progress=None, kno
         else:
             cur = _points(np.array(S), np.array(points))
             ta, tb = r * T_LOOP_SCALE * _crandn(rng, 2)
-            slices = [Slice(problem, start.p0, w, ell, np.zeros_like(ell), a, b - a, True)
-                      for a, b in ((0, ta), (ta, tb), (tb, 0))]
+            slices = [
+                Slice(problem, start.p0, w, ell, np.zeros_like(ell), a, b - a, True)
+                for a, b in ((0, ta), (ta, tb), (tb, 0))
+            ]
         ok, stalled = np.ones(len(cur), bool), np.zeros(len(cur), bool)
         for sl in slices:
             cur, status, _, _ = sl.track_once(unit_gamma(rng), cur)
@@ -244,9 +255,16 @@ def exact_system(problem: Problem, theta, P) -> list:
         d = flint.acb(float(problem.pair[i, 0])) * (theta[i] / 2).cos() if problem.kind[i] else zero
         ct, st, ca, sa = th.cos(), th.sin(), alpha.cos(), alpha.sin()
         A = [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [zero, sa, ca, c + d]]
-        T = [[T[r][0] * A[0][col] + T[r][1] * A[1][col] + T[r][2] * A[2][col] + (T[r][3] if col == 3 else zero)
-              for col in range(4)] for r in range(3)]
-        x = _quat(_quat(x, ((th / 2).cos(), zero, zero, (th / 2).sin())), ((alpha / 2).cos(), (alpha / 2).sin(), zero, zero))
+        T = [
+            [
+                T[r][0] * A[0][col] + T[r][1] * A[1][col] + T[r][2] * A[2][col] + (T[r][3] if col == 3 else zero)
+                for col in range(4)
+            ]
+            for r in range(3)
+        ]
+        x = _quat(
+            _quat(x, ((th / 2).cos(), zero, zero, (th / 2).sin())), ((alpha / 2).cos(), (alpha / 2).sin(), zero, zero)
+        )
     q = (P[3], -P[4], -P[5], -P[6])
     return [T[r][3] - P[r] for r in range(3)] + list(_quat(q, x)[1:])
 
@@ -330,8 +348,7 @@ class TraceTest:
     seconds: float
 
 
-def trace_test(problem: Problem, start: StartSystem, seed: int = 0, progress=None,
-               witnesses=None) -> TraceTest:
+def trace_test(problem: Problem, start: StartSystem, seed: int = 0, progress=None, witnesses=None) -> TraceTest:
     """The trace test of the start set (module docstring), with the start solutions its monodromy
     adds. A failure can also come from witnesses that the monodromy has not reached yet (the last
     ones come slowly): then the monodromy goes on, with twice the quiet loops each time, or, where
@@ -414,9 +431,17 @@ def certify(problem: Problem, start: StartSystem, progress=None) -> StartSystem:
     """The start set with the trace test's verdict (its `certified`, `trace` and `witnesses`), and
     with the solutions the test's monodromy added (then `runs` gets the larger count too)."""
     if start.count > MAX_SOLUTIONS:
-        raise ValueError(f"trace: the start set has {start.count} complex solutions; the trace test is limited to "
-                         f"{MAX_SOLUTIONS} (its witnesses number about ten times as many, far out in the complex)")
+        raise ValueError(
+            f"trace: the start set has {start.count} complex solutions; the trace test is limited to "
+            f"{MAX_SOLUTIONS} (its witnesses number about ten times as many, far out in the complex)"
+        )
     result = trace_test(problem, start, progress=progress)
     runs = start.runs + ([len(result.solutions)] if len(result.solutions) > start.count else [])
-    return dataclasses.replace(start, solutions=result.solutions, runs=runs, certified=result.passed,
-                               trace=result.deviation, witnesses=result.witnesses)
+    return dataclasses.replace(
+        start,
+        solutions=result.solutions,
+        runs=runs,
+        certified=result.passed,
+        trace=result.deviation,
+        witnesses=result.witnesses,
+    )

@@ -2,6 +2,7 @@
 (`apair_ik_track`, threads sharing the paths) or by `track_numpy`; Newton's method at a fixed
 pose (`newton`). The statuses a path ends with, and the settings of the tracker, are here.
 """
+
 from __future__ import annotations
 
 import math
@@ -39,8 +40,14 @@ def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None
         if engine == "c":
             raise RuntimeError("engine: the compiled C kernels are not installed")
         return track_numpy(problem, p0, p1, gamma, start)
-    args = (problem.kind, problem.pair, problem.dh, np.ascontiguousarray(p0, complex),
-            np.ascontiguousarray(p1, complex), complex(gamma))
+    args = (
+        problem.kind,
+        problem.pair,
+        problem.dh,
+        np.ascontiguousarray(p0, complex),
+        np.ascontiguousarray(p1, complex),
+        complex(gamma),
+    )
     return threaded(lambda share: native.ik_track(*args, share, *wide), start)
 
 
@@ -58,8 +65,17 @@ def threaded(track_share, start: np.ndarray):
     return tuple(np.concatenate([part[i] for part in parts]) for i in range(4))
 
 
-def newton(problem: Problem, theta: np.ndarray, p: np.ndarray, max_steps: int, tol: float, floor: float,
-           stall: float, imag_max: float, engine: str | None = None):
+def newton(
+    problem: Problem,
+    theta: np.ndarray,
+    p: np.ndarray,
+    max_steps: int,
+    tol: float,
+    floor: float,
+    stall: float,
+    imag_max: float,
+    engine: str | None = None,
+):
     """Newton's method on F(θ; p) = 0 at the fixed pose p (7,) from each row of theta (k, n):
     (θ (k, n), size (k,)), size the last step's largest entry. A row stops when its step is <= tol,
     or <= floor but above stall × the step before (the rounding floor of a root far out, where the
@@ -68,8 +84,18 @@ def newton(problem: Problem, theta: np.ndarray, p: np.ndarray, max_steps: int, t
     theta = np.ascontiguousarray(theta, complex).reshape(-1, problem.n)
     native = native_in_use() if engine in (None, "c") else None
     if native is not None:
-        return native.ik_newton(problem.kind, problem.pair, problem.dh, np.ascontiguousarray(p, complex), theta,
-                                max_steps, tol, floor, stall, imag_max)
+        return native.ik_newton(
+            problem.kind,
+            problem.pair,
+            problem.dh,
+            np.ascontiguousarray(p, complex),
+            theta,
+            max_steps,
+            tol,
+            floor,
+            stall,
+            imag_max,
+        )
     if engine == "c":
         raise RuntimeError("engine: the compiled C kernels are not installed")
     theta = theta.copy()
@@ -112,8 +138,18 @@ def _pool(threads: int) -> ThreadPoolExecutor:
 
 
 # The tracker's settings: those of apair_ik_default_options in generated/c/apair_ik.c.
-TRACK = {"initial_step": 0.1, "max_step": 0.5, "min_step": 1e-12, "max_steps": 500, "corrector_steps": 3,
-         "path_tol": 1e-7, "final_tol": 1e-14, "final_steps": 30, "divergence": 40.0, "singular_cond": 1e10}
+TRACK = {
+    "initial_step": 0.1,
+    "max_step": 0.5,
+    "min_step": 1e-12,
+    "max_steps": 500,
+    "corrector_steps": 3,
+    "path_tol": 1e-7,
+    "final_tol": 1e-14,
+    "final_steps": 30,
+    "divergence": 40.0,
+    "singular_cond": 1e10,
+}
 
 
 def _batched(problem: Problem, theta, s, p0, dp):
@@ -121,8 +157,9 @@ def _batched(problem: Problem, theta, s, p0, dp):
     kernels (apair.kernels.call, batched)."""
     lw = law(problem, theta)
     target = p0[None, :] + s[:, None] * dp[None, :]
-    F, dF, dFs = kernels.call(f"ik_system{problem.n}", pairs_of(lw), pairs_of(target),
-                              pairs_of(np.broadcast_to(dp, target.shape)), problem.dh)
+    F, dF, dFs = kernels.call(
+        f"ik_system{problem.n}", pairs_of(lw), pairs_of(target), pairs_of(np.broadcast_to(dp, target.shape)), problem.dh
+    )
     return complex_of(F), complex_of(dF), complex_of(dFs)
 
 
@@ -165,7 +202,7 @@ def track_system(evaluate, gamma, start: np.ndarray, angles: int):
 
     def s_of(t):
         den = 1 + (g - 1) * t
-        return g * t / den, g / den ** 2
+        return g * t / den, g / den**2
 
     def tangent(x, t):
         s, ds = s_of(t)
