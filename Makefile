@@ -36,7 +36,7 @@ varieties: install
 # and rebuilt when its sources change.
 EXT_SUFFIX := $(shell $(PYTHON) -c "import sysconfig; print(sysconfig.get_config_var('EXT_SUFFIX'))")
 NATIVE := src/apair/_native$(EXT_SUFFIX)
-NATIVE_SOURCES = $(wildcard generated/c/*.c generated/c/*.h src/csrc/*.c src/csrc/*.h) src/apair/_native.c setup.py
+NATIVE_SOURCES = $(wildcard generated/c/*.c generated/c/*.h src/csrc/*.c src/csrc/*.h src/apair/_native*.c src/apair/_native.h) setup.py
 install: $(NATIVE)
 $(NATIVE): $(DEPS_STAMP) $(NATIVE_SOURCES)
 	$(PY) -m pip install --quiet --no-deps --no-build-isolation -e .
@@ -51,7 +51,7 @@ lib:
 	$(MAKE) --no-print-directory -j$(NPROC) build/libapair.so
 build/libapair.so: $(C_OBJECTS)
 	gcc -shared $^ -o $@ -lm
-build/obj/%.o: generated/c/%.c generated/c/apair.h generated/c/apair_internal.h
+build/obj/%.o: generated/c/%.c $(wildcard generated/c/*.h)
 	@mkdir -p build/obj
 	gcc $(CFLAGS_STRICT) -fPIC -c $< -o $@
 
@@ -79,7 +79,7 @@ test: install lib check browser
 	$(PY) -m pytest -q
 
 # The fast tier (a few minutes): every test not marked slow, without regenerating generated/.
-test-fast: install lib
+test-fast: install lib browser
 	$(PY) -m pytest -q -m "not slow"
 
 # Lint, format, types and the import graph (a layered tree, .importlinter); the same checks run
@@ -88,11 +88,11 @@ lint: $(DEPS_STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 	$(BIN)/mypy
-	$(BIN)/lint-imports --config .importlinter
+	$(BIN)/lint-imports .importlinter
 
 # The documentation site (MkDocs) in build/site; any warning or broken link fails the build.
 docs: $(DEPS_STAMP)
-	$(BIN)/mkdocs build --strict
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
 # The viewer's test drives Debian's Chromium (Playwright, from the test extra, launches it):
 # installed here from the system packages when it is missing.
@@ -103,7 +103,7 @@ $(CHROMIUM):
 	@if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
 	  $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq --no-install-recommends chromium
 
-# The README's pictures of the MuJoCo model and the viewer (off-screen OpenGL by EGL, Chromium).
+# The documentation's pictures of the MuJoCo model and the viewer (off-screen OpenGL by EGL, Chromium).
 pictures: install browser
 	$(PY) docs/pictures.py
 
@@ -122,8 +122,12 @@ $(BENCH_STAMP): pyproject.toml | $(DEPS_STAMP)
 ik-counts: install
 	$(PY) -m apair.ik.homotopy.counts generated/ik_counts.json 6 --trace 48
 
+# A full run (no BENCH_ARGS) also replaces docs/benchmarks/results.json, which the documentation's
+# benchmark tables are rendered from (commit it).
 bench: install $(BENCH_STAMP)
 	PYTHONPATH=. $(PY) bench/run.py $(BENCH_ARGS)
+	@if [ -z "$(BENCH_ARGS)" ]; then cp bench/results.json docs/benchmarks/results.json && \
+	  echo "docs/benchmarks/results.json updated: the documentation's benchmark tables come from it"; fi
 
 clean:
 	rm -rf build .venv *.egg-info src/*.egg-info src/apair/_native*.so

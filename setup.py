@@ -1,6 +1,6 @@
 """Builds the Python binding of the generated C kernels: the extension module apair._native.
 
-It compiles generated/c (the kernels and their registry) with src/apair/_native.c, which calls
+It compiles generated/c (the kernels and their registry) with src/apair/_native*.c, which call
 any registered kernel on NumPy arrays. A failed build (no C compiler, most often) stops the
 install with a message that says what to do, at install time rather than at the first call:
 install gcc, or set APAIR_NO_C=1 to install without the binding (the runtime then uses the
@@ -22,6 +22,9 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 C_FILES = sorted(glob("generated/c/*.c") + glob("generated/c/*.h"))
+# the binding: the module and the kernel registry's calls, Chain, the IK marshaller; their private header
+NATIVE_SOURCES = ["src/apair/_native.c", "src/apair/_native_chain.c", "src/apair/_native_ik.c"]
+NATIVE_HEADERS = ["src/apair/_native.h"]
 
 
 def sources_hash(paths) -> str:
@@ -86,8 +89,8 @@ setup(
     ext_modules=[
         Extension(
             "apair._native",
-            sources=sorted(glob("generated/c/*.c")) + ["src/apair/_native.c"],
-            depends=sorted(glob("generated/c/*.h")),  # rebuild when the header (and its hash) changes
+            sources=sorted(glob("generated/c/*.c")) + NATIVE_SOURCES,
+            depends=sorted(glob("generated/c/*.h")) + NATIVE_HEADERS,  # rebuild when a header (or the hash) changes
             include_dirs=["generated/c", numpy.get_include()],
             extra_compile_args=["-std=c11", "-O2", "-fno-math-errno"],
             libraries=["m"],

@@ -9,7 +9,7 @@ substitute one).
 
 from __future__ import annotations
 
-import json  # noqa: F401 (tests/test_robustness.py reads codegen.emitter.json)
+import json  # noqa: F401 (tests/interface/test_robustness.py reads codegen.emitter.json)
 from pathlib import Path
 
 from .backends import chain

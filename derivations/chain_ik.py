@@ -1,6 +1,6 @@
 """The inverse kinematics of n-joint chains as a homotopy system over the complex numbers.
 
-Path tracking (apair.homotopy, and the tracker apair_ik.c in generated C) continues the solutions of
+Path tracking (apair.ik.homotopy, and the tracker apair_ik_track.c in src/csrc) continues the solutions of
 fk(θ) = T from a generic complex pose to the user's pose, so it needs the equations at complex
 joint values and complex poses, with their derivatives:
 
@@ -490,7 +490,7 @@ def check_system(n: int = 3, digits: int = 30) -> float:
 
 def derive():
     """The law kernels at exp(iθ/2), ik_system6 and ik_residual6 (a shorter chain is tracked with
-    virtual joints added, see apair.homotopy), after the independent checks on n = 1 and 3."""
+    virtual joints added, see apair.ik.homotopy), after the independent checks on n = 1 and 3."""
     checks = {n: check_system(n) for n in (1, 3)}
     checks.update({f"residual{n}": check_residual(n) for n in (1, 3)})
     specs = [law_spec("revolute"), law_spec("sinusoidal"), system_spec(MAX_N), residual_spec(MAX_N)]

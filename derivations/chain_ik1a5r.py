@@ -1,7 +1,7 @@
 """The Raghavan–Roth equations of a six-joint chain with one sinusoidal A-pair, that pair's angle
 hidden: the 1A5R inverse kinematics as an eigenproblem.
 
-The loop A_1 … A_6 = T read from joint k (k = 1, 2, 3, the A-pair; apair.ik1a5r reads a chain
+The loop A_1 … A_6 = T read from joint k (k = 1, 2, 3, the A-pair; apair.ik.elimination1a5r reads a chain
 whose A-pair is joint 4, 5 or 6 from its end) is
 
     A_k A_{k+1} A_{k+2} · A_{k+3} = B · T · C,   B = A_{k−1}⁻¹ … A_1⁻¹,   C = A_6⁻¹ … A_{k+4}⁻¹,
@@ -18,7 +18,7 @@ needed). With the A-pair's half angle (C, S) = (cos θ_k/2, sin θ_k/2) (its off
 
 P on the nine monomials (1, C, …, C⁴, S, S C, …, S C³) (the remainders modulo C² + S² − 1) ⊗
 (1, c, s)_{k+1} ⊗ (1, c, s)_{k+2}, a constant of the design, and Q on (1, c, s)_{r1} ⊗ (1, c, s)_{r2}
-for the two joints r1 < r2 of B and C, a function of the pose. apair.ik1a5r solves it like the 6R
+for the two joints r1 < r2 of B and C, a function of the pose. apair.ik.elimination1a5r solves it like the 6R
 case (a 12 × 12 matrix polynomial of degree 8 in tan((θ_k − σ)/4)): 48 solutions and 48 spurious
 eigenvalues at ±i.
 

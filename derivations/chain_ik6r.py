@@ -14,7 +14,7 @@ equations are, after reduction by cos² + sin² = 1,
 X45 = (1, c4, s4) ⊗ (1, c5, s5) and X12 = (1, c1, s1) ⊗ (1, c2, s2) (c_i, s_i = cos ψ_i, sin ψ_i),
 with P linear in (1, c3, s3): `ik6r_equations` gives P (14, 3, 9), a constant of the design, and Q
 (14, 9), which depends on the pose through u = R_T · A_6⁻¹ e_z and w = T · A_6⁻¹ e_4 alone.
-apair.ik6r eliminates X12's eight non-constant monomials (six combinations of the 14 rows),
+apair.ik.elimination6r eliminates X12's eight non-constant monomials (six combinations of the 14 rows),
 substitutes half-angles and solves the resulting 12 × 12 quadratic matrix polynomial in
 tan(ψ_3/2) as a 24 × 24 eigenproblem: 16 solutions and 8 spurious ones at tan(ψ_3/2) = ±i.
 

@@ -66,7 +66,9 @@ class KernelSpec:
     outputs: list[Arg]
     steps: list[tuple[sp.Symbol, sp.Expr]] = field(default_factory=list)
     calls: list[Call] = field(default_factory=list)
-    wide: bool = False  # also emitted in extended precision (C, apair_wide): see codegen/templates/kernels.c.j2
+    wide: bool = (
+        False  # also emitted in extended precision (C, apair_wide): see codegen/backends/c/templates/kernels.c.j2
+    )
 
     def __post_init__(self):
         for a in self.inputs:

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 45992f3230f49ece
+Content hash: e6d7866099b3212f
 """

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 MAX_DIMS = 24  # batch axes plus a kernel's own (at most 3) stay within NumPy's 32 (and 64) dimensions
 
 
-def real_array(name: str, value, *, trailing: tuple[int, ...] | None = None, ndim_max: int | None = None) -> np.ndarray:
+def real_array(
+    name: str, value: object, *, trailing: tuple[int, ...] | None = None, ndim_max: int | None = None
+) -> NDArray[np.float64]:
     """A finite float64 array; `trailing` fixes the last axes' shape."""
     try:
         raw = np.asarray(value)
@@ -30,7 +33,7 @@ def real_array(name: str, value, *, trailing: tuple[int, ...] | None = None, ndi
     return arr
 
 
-def scalar(name: str, value, *, positive: bool = False, nonnegative: bool = False) -> float:
+def scalar(name: str, value: object, *, positive: bool = False, nonnegative: bool = False) -> float:
     """A finite real scalar, optionally > 0 or ≥ 0."""
     arr = real_array(name, value)
     if arr.ndim != 0:
@@ -43,7 +46,7 @@ def scalar(name: str, value, *, positive: bool = False, nonnegative: bool = Fals
     return x
 
 
-def vector(name: str, value, n: int) -> np.ndarray:
+def vector(name: str, value: object, n: int) -> NDArray[np.float64]:
     """A finite vector of exactly n entries (a scalar is not accepted)."""
     arr = real_array(name, value)
     if arr.shape != (n,):
@@ -51,7 +54,7 @@ def vector(name: str, value, n: int) -> np.ndarray:
     return arr
 
 
-def integer(name: str, value, minimum: int = 1) -> int:
+def integer(name: str, value: object, minimum: int = 1) -> int:
     """An integer ≥ minimum; a float is accepted only when it is a whole number (8.9 is refused,
     not truncated)."""
     if isinstance(value, (bool, np.bool_)):

@@ -11,8 +11,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+from collections.abc import Callable, Iterable, Sequence
+from typing import TYPE_CHECKING, Any, Literal, cast, overload
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _validate as V
 from .files import write_text
@@ -20,6 +24,14 @@ from .kernels import call, native_chain
 from .link import Link
 from .pair import APair
 from .study import normalise
+
+if TYPE_CHECKING:
+    from .ik import LocalSolution, Solution, Solver
+    from .ik.homotopy import StartSystem
+    from .kernels import FastPath
+    from .simulate import Trajectory
+    from .variety import Variety
+    from .workspace import Workspace
 
 MAX_JOINTS = 6
 # The kernel-backed methods in the order of their native fast path (apair.kernels.native_chain):
@@ -43,20 +55,30 @@ class AChain:
     theta_offset (φ). Angles in radians, lengths in metres. `limits`: per joint an explicit range
     (lo, hi) or None for the pair's own (see `limits`)."""
 
+    name: str  # the chain file's name or stem, set by apair.io.load (absent on a chain made here)
+
     def __init__(
-        self, pairs, a, alpha, offset=None, theta_offset=None, links=None, gravity=(0.0, 0.0, -9.81), limits=None
-    ):
+        self,
+        pairs: Iterable[APair],
+        a: ArrayLike,
+        alpha: ArrayLike,
+        offset: ArrayLike | None = None,
+        theta_offset: ArrayLike | None = None,
+        links: Iterable[Link] | None = None,
+        gravity: ArrayLike = (0.0, 0.0, -9.81),
+        limits: Iterable[ArrayLike | None] | None = None,
+    ) -> None:
         try:
-            pairs = list(pairs)
+            pair_list = list(pairs)
         except TypeError as exc:
             raise ValueError(f"pairs: expected a sequence of APair, got {pairs!r}") from exc
-        n = len(pairs)
+        n = len(pair_list)
         if not 1 <= n <= MAX_JOINTS:
             raise ValueError(f"pairs: a chain has 1 to {MAX_JOINTS} pairs, got {n}")
-        for i, p in enumerate(pairs):
+        for i, p in enumerate(pair_list):
             if not isinstance(p, APair):
                 raise ValueError(f"pairs[{i}]: expected an APair, got {type(p).__name__}")
-        self.pairs = pairs
+        self.pairs: list[APair] = pair_list
         self.a = V.vector("a", a, n)
         self.alpha = V.vector("alpha", alpha, n)
         self.offset = np.zeros(n) if offset is None else V.vector("offset", offset, n)
@@ -65,50 +87,50 @@ class AChain:
         if links is None:
             links = [Link(0.0) for _ in range(n)]
         try:
-            links = list(links)
+            link_list = list(links)
         except TypeError as exc:
             raise ValueError(f"links: expected a sequence of Link, got {links!r}") from exc
-        if len(links) != n:
-            raise ValueError(f"links: expected {n} links (one per pair), got {len(links)}")
-        for i, link in enumerate(links):
+        if len(link_list) != n:
+            raise ValueError(f"links: expected {n} links (one per pair), got {len(link_list)}")
+        for i, link in enumerate(link_list):
             if not isinstance(link, Link):
                 raise ValueError(f"links[{i}]: expected a Link, got {type(link).__name__}")
-        self.links = links
+        self.links: list[Link] = link_list
         self.gravity = V.vector("gravity", gravity, 3)
         self._links = np.ascontiguousarray(np.stack([link.as_row() for link in links]))
-        self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pairs])
+        self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pair_list])
         self._gravity = np.ascontiguousarray(self.gravity)
         self._law_groups = self._group_laws()
-        self._ranged = [i for i, p in enumerate(pairs) if p.theta_limit is not None]  # angles to check
-        self._ik = None  # the inverse-kinematics solver, built on the first call of ik()
+        self._ranged = [i for i, p in enumerate(pair_list) if p.theta_limit is not None]  # angles to check
+        self._ik: Solver | None = None  # the inverse-kinematics solver, built on the first call of ik()
         self._explicit_limits = self._check_limits(limits)
         self._use(self._native_chain())
 
-    def _use(self, fast) -> None:
+    def _use(self, fast: FastPath) -> None:
         """Take `fast` (kernels.native_chain) as the methods' fast path; its bound call is kept,
         since an attribute lookup less is measurable at single calls."""
         self._fast, self._call = fast, fast.call
 
-    def __getstate__(self):
+    def __getstate__(self) -> dict[str, Any]:
         state = dict(self.__dict__)
         del state["_fast"], state["_call"]  # native objects: rebuilt on unpickling
         return state
 
-    def __setstate__(self, state):
+    def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
         self._use(self._native_chain())
 
-    def _check_limits(self, limits):
+    def _check_limits(self, limits: Iterable[ArrayLike | None] | None) -> list[tuple[float, float] | None]:
         if limits is None:
             return [None] * self.n
         try:
-            limits = list(limits)
+            entries = list(limits)
         except TypeError as exc:
             raise ValueError(f"limits: expected one (lo, hi) or None per pair, got {limits!r}") from exc
-        if len(limits) != self.n:
-            raise ValueError(f"limits: expected {self.n} entries (one per pair), got {len(limits)}")
-        out = []
-        for i, lim in enumerate(limits):
+        if len(entries) != self.n:
+            raise ValueError(f"limits: expected {self.n} entries (one per pair), got {len(entries)}")
+        out: list[tuple[float, float] | None] = []
+        for i, lim in enumerate(entries):
             if lim is None:
                 out.append(None)
                 continue
@@ -125,7 +147,7 @@ class AChain:
         return out
 
     @property
-    def limits(self) -> np.ndarray:
+    def limits(self) -> NDArray[np.float64]:
         """(n, 2): each joint's range [rad]: the explicit one if given, else the pair's collision
         limits (`APair.collision_limits`), within its range of motion; a free joint gets one turn
         (−π, π)."""
@@ -133,7 +155,7 @@ class AChain:
         out[~np.isfinite(out).all(axis=1)] = -math.pi, math.pi
         return out
 
-    def hard_limits(self) -> np.ndarray:
+    def hard_limits(self) -> NDArray[np.float64]:
         """(n, 2): the ranges that physically stop each joint (explicit, collision limits, range
         ends), ±inf for a joint that turns freely (as `simulate` uses them)."""
         out = np.empty((self.n, 2))
@@ -152,16 +174,15 @@ class AChain:
             f"links={self.links!r}, gravity={self.gravity.tolist()})"
         )
 
-    def _q(self, q, name: str = "q") -> np.ndarray:
-        q = V.real_array(name, q, trailing=(self.n,))
-        return q
+    def _q(self, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
+        return V.real_array(name, q, trailing=(self.n,))
 
-    def _group_laws(self):
+    def _group_laws(self) -> list[tuple[str, NDArray[np.intp], list[NDArray[np.float64]]]]:
         """One call per law kernel (APair.law_kernel): (kernel, joint indices, parameters (k, 1))."""
         by_kernel: dict[str, list[int]] = {}
         for i, p in enumerate(self.pairs):
             by_kernel.setdefault(p.law_kernel[0], []).append(i)
-        groups = []
+        groups: list[tuple[str, NDArray[np.intp], list[NDArray[np.float64]]]] = []
         for kernel, idx in sorted(by_kernel.items()):
             values = np.array([self.pairs[i].law_kernel[1] for i in idx])
             groups.append(
@@ -169,7 +190,7 @@ class AChain:
             )
         return groups
 
-    def _native_chain(self):
+    def _native_chain(self) -> FastPath:
         """The native fast path of the methods (apair.kernels.native_chain): per method its
         generic chain kernel, fed by the pairs' law kernels."""
         return native_chain(
@@ -180,11 +201,11 @@ class AChain:
             {"dh": self._dh, "links": self._links, "legs": self._legs, "gravity": self._gravity},
         )
 
-    def law(self, q) -> np.ndarray:
+    def law(self, q: ArrayLike) -> NDArray[np.float64]:
         """(..., n, 3): each joint's (d, d', d'') at q."""
         return self._law(self._snapped(self._q(q)))[..., 2:]
 
-    def _snapped(self, q: np.ndarray) -> np.ndarray:
+    def _snapped(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
         """A validated q with the angles past a range end by rounding put on it (each pair with
         a restricted range checks its angles)."""
         for i in self._ranged:
@@ -194,7 +215,7 @@ class AChain:
                 q[..., i] = snapped
         return q
 
-    def _law(self, q: np.ndarray) -> np.ndarray:
+    def _law(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
         """(..., n, 5): the chain kernels' law input (cos(θ/2), sin(θ/2), d, d', d'') of a
         validated, snapped q."""
         out = np.empty(q.shape + (5,))
@@ -202,7 +223,7 @@ class AChain:
             out[..., idx, :] = call(kernel, q[..., idx, None], *params)[0]
         return out
 
-    def _state(self, q, strict: bool = True, **named) -> list[np.ndarray]:
+    def _state(self, q: ArrayLike, strict: bool = True, **named: ArrayLike) -> list[NDArray[np.float64]]:
         """Validated, snapped q and the named (n,)-arrays (qd, qdd, tau), broadcast to one batch
         shape, C-contiguous; with `strict`, a joint at its range end (where d' is unbounded) is
         refused."""
@@ -216,11 +237,19 @@ class AChain:
         for i in self._ranged if strict else ():  # at the range end (up to rounding) d' is unbounded
             t = arrays[0][..., i]
             t = np.abs(t - 2 * np.pi * np.round(t / (2 * np.pi)))
-            if np.any(t >= self.pairs[i].theta_limit):
+            if np.any(t >= cast(float, self.pairs[i].theta_limit)):  # _ranged: the pairs with a limit
                 raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
         return arrays
 
-    def _evaluate(self, method: int, family: str, q, design, strict: bool = True, **named) -> np.ndarray:
+    def _evaluate(
+        self,
+        method: int,
+        family: str,
+        q: ArrayLike,
+        design: Sequence[NDArray[np.float64]],
+        strict: bool = True,
+        **named: ArrayLike,
+    ) -> NDArray[np.float64]:
         """The validating path of a method: checks and converts the inputs (a ValueError names
         the argument), then the fast path again, else the law kernels and the generic kernel of
         `family` with the `design` inputs after the state."""
@@ -233,48 +262,48 @@ class AChain:
             out = call(f"{family}{self.n}", law, *arrays[1:], *design)[0]
         return out
 
-    def fk(self, q) -> np.ndarray:
+    def fk(self, q: ArrayLike) -> NDArray[np.float64]:
         """(..., 4, 4): the pose of frame n in the base frame; q is (n,) or (..., n)."""
         out = self._call(0, q)
         return out if out is not None else self._evaluate(0, "fk", q, (self._dh,), strict=False)
 
-    def fk_study(self, q) -> np.ndarray:
+    def fk_study(self, q: ArrayLike) -> NDArray[np.float64]:
         """(..., 8): the Study point (x0..x3, y0..y3) of fk(q), with |x| = 1; (x, y) ~ (−x, −y)."""
         out = self._call(1, q)
         return normalise(out if out is not None else self._evaluate(1, "fk_study", q, (self._dh,), strict=False))
 
-    def jacobian(self, q) -> np.ndarray:
+    def jacobian(self, q: ArrayLike) -> NDArray[np.float64]:
         """(..., 6, n): geometric Jacobian, base frame, rows [v; ω] (v of the origin of frame n)."""
         out = self._call(2, q)
         return out if out is not None else self._evaluate(2, "jacobian", q, (self._dh,))
 
     # ----------------------------------------------------------------------------- dynamics
-    def mass_matrix(self, q) -> np.ndarray:
+    def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
         """(..., n, n): M(θ), legs included."""
         out = self._call(3, q)
         return out if out is not None else self._evaluate(3, "mass_matrix", q, self._body[:3])
 
-    def coriolis_matrix(self, q, qd) -> np.ndarray:
+    def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
         """(..., n, n): C(θ, θ') in Christoffel form (Ṁ − 2C is skew-symmetric)."""
         out = self._call(4, q, qd)
         return out if out is not None else self._evaluate(4, "coriolis", q, self._body[:3], qd=qd)
 
-    def gravity_torques(self, q) -> np.ndarray:
+    def gravity_torques(self, q: ArrayLike) -> NDArray[np.float64]:
         """(..., n): g(θ) = ∂V/∂θ."""
         out = self._call(5, q)
         return out if out is not None else self._evaluate(5, "gravity", q, self._body)
 
-    def bias(self, q, qd) -> np.ndarray:
+    def bias(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
         """(..., n): C(θ, θ')θ' + g(θ)."""
         out = self._call(6, q, qd)
         return out if out is not None else self._evaluate(6, "bias", q, self._body, qd=qd)
 
-    def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
+    def inverse_dynamics(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
         """(..., n): τ = M(θ)θ'' + C(θ, θ')θ' + g(θ), torques about the pair axes."""
         out = self._call(7, q, qd, qdd)
         return out if out is not None else self._evaluate(7, "inverse_dynamics", q, self._body, qd=qd, qdd=qdd)
 
-    def forward_dynamics(self, q, qd, tau) -> np.ndarray:
+    def forward_dynamics(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike) -> NDArray[np.float64]:
         """(..., n): θ'' = M⁻¹(τ − C θ' − g), by a Cholesky factorisation of M inside one kernel."""
         out = self._call(8, q, qd, tau)
         if out is None:
@@ -286,16 +315,16 @@ class AChain:
                 )
         return out
 
-    def energy(self, q, qd) -> np.ndarray:
+    def energy(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
         """(..., 2): kinetic and potential energy (T, V) [J], legs included."""
         out = self._call(9, q, qd)
         return out if out is not None else self._evaluate(9, "energy", q, self._body, qd=qd)
 
     @property
-    def _body(self) -> tuple[np.ndarray, ...]:
+    def _body(self) -> tuple[NDArray[np.float64], ...]:
         return self._dh, self._links, self._legs, self._gravity
 
-    def specialise(self, kernels=None) -> AChain:
+    def specialise(self, kernels: Iterable[str] | None = None) -> AChain:
         """This chain with its design built into its own kernels (`apair codegen`'s C, compiled
         once into the cache, see apair.files.cache_root, and found again by content hash):
         the same methods, faster. `kernels`: a subset of fk, fk_study, jacobian, mass_matrix,
@@ -304,7 +333,13 @@ class AChain:
         (`.specialised` says which)."""
         return SpecialisedChain(self, kernels)
 
-    def to_mjcf(self, q=None, path=None, overwrite: bool = False, collisions: bool = False) -> str:
+    def to_mjcf(
+        self,
+        q: ArrayLike | None = None,
+        path: str | os.PathLike[str] | None = None,
+        overwrite: bool = False,
+        collisions: bool = False,
+    ) -> str:
         """The MuJoCo model (MJCF) of the mechanism, every A-pair as its Griffis-Duffy platform with
         six legs closed by equality constraints (apair.mjcf); keyframe 0 is q (default: all zero).
         Written to `path` too if given (an existing file only with overwrite=True). Returns the XML."""
@@ -315,7 +350,7 @@ class AChain:
             write_text(path, xml, overwrite, ".xml")
         return xml
 
-    def to_html(self, path=None, overwrite: bool = False, workspace: int = 0) -> str:
+    def to_html(self, path: str | os.PathLike[str] | None = None, overwrite: bool = False, workspace: int = 0) -> str:
         """The interactive 3D viewer of the chain as one offline HTML page (apair.view); written to
         `path` too if given (an existing file only with overwrite=True). Returns the HTML."""
         from . import view
@@ -325,7 +360,17 @@ class AChain:
             write_text(path, html, overwrite, ".html")
         return html
 
-    def simulate(self, q0, qd0, t, tau=None, rtol=1e-10, atol=1e-12, method="DOP853", limits="stop"):
+    def simulate(
+        self,
+        q0: ArrayLike,
+        qd0: ArrayLike,
+        t: ArrayLike,
+        tau: ArrayLike | Callable[[float, NDArray[np.float64], NDArray[np.float64]], ArrayLike] | None = None,
+        rtol: float = 1e-10,
+        atol: float = 1e-12,
+        method: str = "DOP853",
+        limits: str = "stop",
+    ) -> Trajectory:
         """Integrate the equations of motion from (q0, qd0) and report the state at times `t`.
 
         tau: None (free motion), an array (n,), or a callable tau(t, q, qd) -> (n,).
@@ -340,7 +385,7 @@ class AChain:
         return simulate(self, q0, qd0, t, tau, rtol=rtol, atol=atol, method=method, limits=limits)
 
     # ----------------------------------------------------------------------------- varieties
-    def constraint_variety(self, max_degree: int = 4, seed: int = 0):
+    def constraint_variety(self, max_degree: int = 4, seed: int = 0) -> Variety:
         """2-pair chains: homogeneous sympy.Poly in x0..y3 (the Study quadric included) that
         generate every form of degree ≤ max_degree vanishing on all poses of the chain.
 
@@ -354,7 +399,21 @@ class AChain:
         return constraint_variety(self, max_degree=max_degree, seed=seed)
 
     # ----------------------------------------------------------------------------- inverse kinematics
-    def ik(self, T, tol: float = 1e-9, full: bool = False, within_limits: bool = False):
+    @overload
+    def ik(
+        self, T: ArrayLike, tol: float = ..., full: Literal[False] = ..., within_limits: bool = ...
+    ) -> NDArray[np.float64]: ...
+    @overload
+    def ik(self, T: ArrayLike, tol: float = ..., *, full: Literal[True], within_limits: bool = ...) -> Solution: ...
+    @overload
+    def ik(self, T: ArrayLike, tol: float, full: Literal[True], within_limits: bool = ...) -> Solution: ...
+    @overload
+    def ik(
+        self, T: ArrayLike, tol: float = ..., full: bool = ..., within_limits: bool = ...
+    ) -> NDArray[np.float64] | Solution: ...
+    def ik(
+        self, T: ArrayLike, tol: float = 1e-9, full: bool = False, within_limits: bool = False
+    ) -> NDArray[np.float64] | Solution:
         """All real joint vectors q (k, n) with fk(q) = T, each verified (largest entry of
         |fk(q) − T| ≤ tol); (0, n) when T is out of reach. T: a 4×4 transform or a Study point.
         within_limits=True keeps only the solutions inside `limits` (no collisions).
@@ -386,7 +445,9 @@ class AChain:
             inside = inside[inside]
         return dataclasses.replace(sol, inside=inside) if full else sol.q
 
-    def prepare_ik(self, progress=None, refresh: bool = False, trace: bool = False):
+    def prepare_ik(
+        self, progress: Callable[[int, int], object] | None = None, refresh: bool = False, trace: bool = False
+    ) -> StartSystem:
         """n = 5, 6: the design's homotopy start system (every complex solution at a generic complex
         pose, by monodromy), from the cache or computed now and cached (`apair ik-prepare`).
         trace: also run the trace test (apair.ik.homotopy.trace: seconds up to 48 solutions, minutes
@@ -401,12 +462,14 @@ class AChain:
                 f"chain: start systems are for 5 and 6 joints (this chain has {self.n}; its ik is "
                 "solved by elimination)"
             )
-        certify = None
+        certify: Callable[..., StartSystem] | None = None
         if trace:
-            from .ik.homotopy.trace import certify
+            from .ik.homotopy.trace import certify as trace_test
+
+            certify = trace_test
         return homotopy.start_system(homotopy.Problem.of(self), progress=progress, refresh=refresh, certify=certify)
 
-    def ik_local(self, T, q0, tol: float = 1e-10, max_iter: int = 100):
+    def ik_local(self, T: ArrayLike, q0: ArrayLike, tol: float = 1e-10, max_iter: int = 100) -> LocalSolution:
         """The solution nearest (in the damped least-squares sense) to each seed: Levenberg-Marquardt
         from q0 (n,) or (..., n) to T (4, 4) or (..., 4, 4), broadcast together, every step kept
         inside `limits`; in C on the fk and Jacobian kernels. Returns `apair.ik.LocalSolution`
@@ -421,10 +484,10 @@ class AChain:
         resolution: int = 24,
         rounds: int = 4,
         poses: bool = False,
-        engine=None,
+        engine: object = None,
         seed: int = 0,
-        progress=None,
-    ):
+        progress: Callable[[int, int], object] | None = None,
+    ) -> Workspace:
         """The reachable workspace of the end-effector origin inside `limits` (apair.workspace):
         `.points`, `.boundary`, `.volume`, `.volume_error` (one standard uncertainty), `.plot(path)`.
         engine: None (this process), "threads"/"processes" (local Dask) or a dask.distributed
@@ -442,7 +505,7 @@ class AChain:
             progress=progress,
         )
 
-    def within_limits(self, q) -> np.ndarray:
+    def within_limits(self, q: ArrayLike) -> NDArray[np.bool_]:
         """(...): whether each joint vector lies inside `limits` (bounds included)."""
         q = self._q(q)
         lim = self.limits
@@ -454,7 +517,7 @@ class SpecialisedChain(AChain):
     kernels (AChain.specialise, built by apair.specialise); everything else is the AChain's. Where
     they cannot be had (no C compiler), the generic kernels serve, as said once in a warning."""
 
-    def __init__(self, chain: AChain, kernels=None):
+    def __init__(self, chain: AChain, kernels: Iterable[str] | None = None) -> None:
         from .specialise import check_kernels, content_hash
 
         self.__dict__.update({k: v for k, v in chain.__dict__.items() if k not in ("_fast", "_call")})
@@ -473,7 +536,7 @@ class SpecialisedChain(AChain):
         if fast is not None:
             self._use(fast)
 
-    def __setstate__(self, state):
+    def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
         self._attach()
 

@@ -6,8 +6,11 @@ import argparse
 import json
 import os
 import sys
+from collections.abc import Callable, Sequence
+from typing import cast
 
 import numpy as np
+from numpy.typing import NDArray
 
 from . import polynomials
 from ._version import __version__
@@ -15,14 +18,14 @@ from .io import load
 from .kernels import backend, manifest
 
 
-def _cmd_list(args) -> int:
+def _cmd_list(args: argparse.Namespace) -> int:
     for name in polynomials.names():
         data = polynomials.raw(name)
         print(f"{name:16s} {len(data['entries']):3d} entries  {data['title']}")
     return 0
 
 
-def _cmd_show(args) -> int:
+def _cmd_show(args: argparse.Namespace) -> int:
     if args.name == "ik_counts":
         return _show_ik_counts(args)
     if args.json:
@@ -32,7 +35,7 @@ def _cmd_show(args) -> int:
     return 0
 
 
-def _show_ik_counts(args) -> int:
+def _show_ik_counts(args: argparse.Namespace) -> int:
     from .ik.homotopy import stored_counts
 
     rows = stored_counts()
@@ -55,7 +58,7 @@ def _show_ik_counts(args) -> int:
     return 0
 
 
-def _cmd_ik_prepare(args) -> int:
+def _cmd_ik_prepare(args: argparse.Namespace) -> int:
     from .ik.homotopy.trace import MAX_SOLUTIONS
 
     chain = load(args.file)
@@ -64,11 +67,13 @@ def _cmd_ik_prepare(args) -> int:
             f"{args.file}: {chain.n} joints; start systems are for 5 and 6 joints (fewer are solved "
             "by elimination, nothing to prepare)"
         )
-    progress = None
+    progress: Callable[[int, int], None] | None = None
     if not args.quiet:
 
-        def progress(loops, count):
+        def show(loops: int, count: int) -> None:
             print(f"\rmonodromy: loop {loops:4d}, {count:6d} points", end="", file=sys.stderr, flush=True)
+
+        progress = show
 
     start = chain.prepare_ik(progress=progress, refresh=args.refresh, trace=args.trace)
     if progress:
@@ -83,7 +88,7 @@ def _cmd_ik_prepare(args) -> int:
     return 0
 
 
-def _parse_numbers(name: str, values) -> np.ndarray:
+def _parse_numbers(name: str, values: Sequence[str]) -> NDArray[np.float64]:
     """Command-line words as floats; a word that is not a number is an error naming `name`."""
     out = []
     for v in values:
@@ -94,12 +99,12 @@ def _parse_numbers(name: str, values) -> np.ndarray:
     return np.array(out)
 
 
-def _parse_angles(values, deg: bool) -> np.ndarray:
+def _parse_angles(values: Sequence[str], deg: bool) -> NDArray[np.float64]:
     q = _parse_numbers("Q", values)
     return np.radians(q) if deg else q
 
 
-def _cmd_fk(args) -> int:
+def _cmd_fk(args: argparse.Namespace) -> int:
     chain = load(args.file)
     q = _parse_angles(args.q, args.deg)
     if q.shape != (chain.n,):
@@ -115,7 +120,7 @@ def _cmd_fk(args) -> int:
     return 0
 
 
-def _cmd_demo(args) -> int:
+def _cmd_demo(args: argparse.Namespace) -> int:
     motion = polynomials.load("apair_motion")
     print("The A-pair, derived from the six leg constraints of a Griffis-Duffy platform:")
     for label in (
@@ -142,7 +147,7 @@ def _cmd_demo(args) -> int:
     return 0
 
 
-def _cmd_variety(args) -> int:
+def _cmd_variety(args: argparse.Namespace) -> int:
     import sympy as sp
 
     chain = load(args.file)
@@ -174,7 +179,7 @@ def _cmd_variety(args) -> int:
     return 0
 
 
-def _parse_pose(values) -> np.ndarray:
+def _parse_pose(values: Sequence[str]) -> NDArray[np.float64]:
     x = _parse_numbers("POSE", values)
     if len(x) == 16:
         return x.reshape(4, 4)
@@ -187,7 +192,7 @@ def _parse_pose(values) -> np.ndarray:
     )
 
 
-def _cmd_ik(args) -> int:
+def _cmd_ik(args: argparse.Namespace) -> int:
     from .ik import distance
 
     chain = load(args.file)
@@ -208,13 +213,13 @@ def _cmd_ik(args) -> int:
             f"{chain.name}: {len(sol.q)} real solution(s){count}, by {sol.method}{complete}; angles in rad"
             f"{' and deg' if args.deg else ''}"
         )
-        for q, e, ok in zip(sol.q, sol.error, sol.inside):
+        for q, e, ok in zip(sol.q, sol.error, cast(NDArray[np.bool_], sol.inside)):  # set by full=True
             extra = f"  = {np.degrees(q)} deg" if args.deg else ""
             print(f"  q = {q}{extra}   |fk(q) - T| = {e:.1e}   {'within' if ok else 'OUTSIDE'} the joint limits")
     return 0
 
 
-def _cmd_limits(args) -> int:
+def _cmd_limits(args: argparse.Namespace) -> int:
     chain = load(args.file)
     lim = chain.limits
     print(f"{chain.name}: joint ranges [deg] (explicit, or where the legs or plates first touch)")
@@ -231,7 +236,7 @@ def _cmd_limits(args) -> int:
     return 0
 
 
-def _cmd_workspace(args) -> int:
+def _cmd_workspace(args: argparse.Namespace) -> int:
     from .workspace import text_progress
 
     chain = load(args.file)
@@ -259,7 +264,7 @@ def _cmd_workspace(args) -> int:
     return 0
 
 
-def _cmd_export(args) -> int:
+def _cmd_export(args: argparse.Namespace) -> int:
     chain = load(args.file)
     q = None if args.q is None else _parse_angles(args.q.split(","), args.deg)
     from . import mjcf
@@ -275,7 +280,7 @@ def _cmd_export(args) -> int:
     return 0
 
 
-def _cmd_view(args) -> int:
+def _cmd_view(args: argparse.Namespace) -> int:
     from . import view
 
     chain = load(args.file)
@@ -286,7 +291,7 @@ def _cmd_view(args) -> int:
     return 0
 
 
-def _cmd_kernels(args) -> int:
+def _cmd_kernels(args: argparse.Namespace) -> int:
     for name, k in sorted(manifest()["kernels"].items()):
         ins = ", ".join(f"{a['name']}{tuple(a['shape'])}" for a in k["inputs"])
         outs = ", ".join(f"{a['name']}{tuple(a['shape'])}" for a in k["outputs"])
@@ -294,7 +299,7 @@ def _cmd_kernels(args) -> int:
     return 0
 
 
-def _cmd_codegen(args) -> int:
+def _cmd_codegen(args: argparse.Namespace) -> int:
     import time
 
     from . import specialise
@@ -440,7 +445,7 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Run one command; every failure ends in a one-line message and a non-zero exit, never a
     traceback: 2 for bad input, 1 for an unreachable pose, 141 when the reader of the output went
     away (`apair kernels | head`), 130 on Ctrl-C, 3 for an internal error."""

@@ -20,11 +20,21 @@ are the nearest touches on either side of θ = 0.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Sequence
 from fractions import Fraction
 from functools import lru_cache
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple, TypeVar, cast
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+if TYPE_CHECKING:
+    import flint  # an optional dependency, imported where it is used
+
+    from ._typing import PairLike
+
+# a pair, passed through (unit_pair makes it again by its own class)
+P = TypeVar("P", bound="PairLike")
 
 LEG_PAIRS = [(i, j) for i in range(6) for j in range(i + 1, 6)]
 _TOUCH_RTOL = 1e-9  # |clearance| at a touch, relative to the pair's size
@@ -40,7 +50,7 @@ class CollisionLimits(NamedTuple):
 
 
 @lru_cache(maxsize=1)
-def _pieces() -> list[tuple[str, list]]:
+def _pieces() -> list[tuple[str, list[tuple[tuple[int, ...], Fraction]]]]:
     """[(label, [(exponents of c, s, d, q3, r_b, r_p, rho, tau), Fraction])] from the generated set."""
     import sympy as sp
 
@@ -55,7 +65,7 @@ def _pieces() -> list[tuple[str, list]]:
     return out
 
 
-def _tpoly(coeffs):
+def _tpoly(coeffs: Iterable[Fraction]) -> flint.fmpq_poly:
     import flint
 
     return flint.fmpq_poly([flint.fmpq(f.numerator, f.denominator) for f in coeffs])
@@ -64,30 +74,37 @@ def _tpoly(coeffs):
 class _Q3:
     """Polynomials in t over Q(√3), as a pair (P₀, P₁) meaning P₀ + √3·P₁."""
 
-    def __init__(self, p0, p1=None):
+    def __init__(self, p0: flint.fmpq_poly, p1: flint.fmpq_poly | None = None) -> None:
         import flint
 
         self.p0, self.p1 = p0, p1 if p1 is not None else flint.fmpq_poly([])
 
-    def __add__(self, o):
+    def __add__(self, o: _Q3) -> _Q3:
         return _Q3(self.p0 + o.p0, self.p1 + o.p1)
 
-    def __sub__(self, o):
+    def __sub__(self, o: _Q3) -> _Q3:
         return _Q3(self.p0 - o.p0, self.p1 - o.p1)
 
-    def __mul__(self, o):
+    def __mul__(self, o: _Q3 | flint.fmpq_poly) -> _Q3:
         if isinstance(o, _Q3):
             return _Q3(self.p0 * o.p0 + 3 * self.p1 * o.p1, self.p0 * o.p1 + self.p1 * o.p0)
         return _Q3(self.p0 * o, self.p1 * o)
 
-    def norm(self):
+    def norm(self) -> flint.fmpq_poly:
         """P₀² − 3P₁²: rational, vanishing wherever P₀ + √3·P₁ does (P₀ itself when P₁ = 0)."""
         if self.p1 == 0:
             return self.p0
         return self.p0 * self.p0 - 3 * self.p1 * self.p1
 
 
-def contact_polynomials(r_b, r_p, a, b, rho, tau) -> list[tuple[str, object]]:
+def contact_polynomials(
+    r_b: float | Fraction,
+    r_p: float | Fraction,
+    a: float | Fraction,
+    b: float | Fraction,
+    rho: float | Fraction,
+    tau: float | Fraction,
+) -> list[tuple[str, flint.fmpq_poly]]:
     """[(label, fmpq_poly in t = tan(θ/4))] whose real roots contain every touch of this design."""
     import flint
 
@@ -99,7 +116,7 @@ def contact_polynomials(r_b, r_p, a, b, rho, tau) -> list[tuple[str, object]]:
     out = []
     for label, terms in _pieces():
         # collect A + d·B, each as {power of 1/(1 + t²): Q(√3)[t]}
-        parts = {0: {}, 1: {}}
+        parts: dict[int, dict[int, _Q3]] = {0: {}, 1: {}}
         for (i, j, k, l, *p), coef in terms:
             value = coef * math.prod(v**e for v, e in zip(vals, p))
             if value == 0:
@@ -113,6 +130,7 @@ def contact_polynomials(r_b, r_p, a, b, rho, tau) -> list[tuple[str, object]]:
             bucket[den] = bucket[den] + term if den in bucket else term
         A, kA = _combine(parts[0], one_t2)
         B, kB = _combine(parts[1], one_t2)
+        G: _Q3 | None
         if B is None:
             G = A
         elif A is None:
@@ -121,24 +139,24 @@ def contact_polynomials(r_b, r_p, a, b, rho, tau) -> list[tuple[str, object]]:
             lhs = A * A * one_t2 ** (2 * kB + 2)
             rhs = B * B * d2 * one_t2 ** (2 * kA)
             G = lhs - rhs
-        poly = G.norm()
+        poly = cast(_Q3, G).norm()  # every piece has a term that no zero design value removes
         if poly != 0:
             out.append((label, poly))
     return out
 
 
-def _combine(bucket, one_t2):
+def _combine(bucket: dict[int, _Q3], one_t2: flint.fmpq_poly) -> tuple[_Q3 | None, int]:
     if not bucket:
         return None, 0
     K = max(bucket)
-    total = None
+    total: _Q3 | None = None
     for k, v in bucket.items():
         v = v * one_t2 ** (K - k)
         total = v if total is None else total + v
     return total, K
 
 
-def real_roots_t(poly) -> list[float]:
+def real_roots_t(poly: flint.fmpq_poly) -> list[float]:
     """The real roots of a rational polynomial, isolated by FLINT and given to double precision."""
     import flint
 
@@ -151,7 +169,7 @@ def real_roots_t(poly) -> list[float]:
     return [float(r.mid()) for r in real]
 
 
-def segment_distance(P0, P1, Q0, Q1) -> np.ndarray:
+def segment_distance(P0: ArrayLike, P1: ArrayLike, Q0: ArrayLike, Q1: ArrayLike) -> NDArray[np.float64]:
     """Distance between segments P0P1 and Q0Q1, broadcasting over leading axes (…, 3); computed
     in units of the largest coordinate, so that no product over- or underflows at any scale."""
     unit = max(float(np.abs(x).max(initial=0.0)) for x in (P0, P1, Q0, Q1)) or 1.0
@@ -169,7 +187,7 @@ def segment_distance(P0, P1, Q0, Q1) -> np.ndarray:
     return unit * np.linalg.norm(gap, axis=-1)
 
 
-def clearances(pair, theta) -> tuple[np.ndarray, np.ndarray]:
+def clearances(pair: PairLike, theta: ArrayLike) -> tuple[NDArray[np.float64], float | NDArray[np.float64]]:
     """(…, 15) surface clearance of every leg pair (segment distance − 2·leg_radius) and (…) plate
     gap d − thickness, at the angles θ."""
     pts = pair.leg_endpoints(theta)
@@ -185,7 +203,7 @@ def _rational(x: float) -> Fraction:
     return Fraction(x).limit_denominator(10**12)
 
 
-def unit_pair(pair):
+def unit_pair(pair: P) -> P:
     """The same pair (an APair, made by its own class) in units of its size r_b + r_p (collision
     angles do not depend on scale)."""
     s = pair.base_radius + pair.platform_radius
@@ -199,7 +217,7 @@ def unit_pair(pair):
     )
 
 
-def limits(pair) -> CollisionLimits:
+def limits(pair: PairLike) -> CollisionLimits:
     """The collision-free interval around θ = 0 (see the module docstring), computed on the pair
     in units of its size, so that the answer is the same at every scale."""
     if pair.kind == "revolute":
@@ -224,11 +242,11 @@ def limits(pair) -> CollisionLimits:
         a = b = r_b * r_p
     else:  # the design kernel's constants, as the runtime's d(θ) uses them
         a, b = _rational(pair.a), _rational(pair.b)
-    candidates = set()
+    roots: set[float] = set()
     for _, poly in contact_polynomials(r_b, r_p, a, b, _rational(2 * pair.leg_radius), _rational(pair.thickness)):
-        candidates.update(4 * math.atan(t) for t in real_roots_t(poly))
+        roots.update(4 * math.atan(t) for t in real_roots_t(poly))
     lim = pair.theta_limit
-    candidates = sorted(th for th in candidates if th != 0 and (lim is None or abs(th) <= lim))
+    candidates = sorted(th for th in roots if th != 0 and (lim is None or abs(th) <= lim))
     upper = _first_touch([th for th in candidates if th > 0], pair, size)
     lower = _first_touch(sorted((th for th in candidates if th < 0), reverse=True), pair, size)
     if end is not None:  # a general pair with a < b: its motion ends at d = 0, the plates coplanar
@@ -241,12 +259,12 @@ def limits(pair) -> CollisionLimits:
     return CollisionLimits(theta_min, theta_max, what_max if theta_max <= -theta_min else what_min)
 
 
-def _first_touch(ordered, pair, size):
+def _first_touch(ordered: Sequence[float], pair: PairLike, size: float) -> tuple[float, str] | None:
     """The first candidate (in the given order) where the clearance is zero, and what touches."""
     if not ordered:
         return None
     all_legs, all_plates = clearances(pair, np.array(ordered))
-    for th, legs, plate in zip(ordered, all_legs, all_plates):
+    for th, legs, plate in zip(ordered, all_legs, cast(NDArray[np.float64], all_plates)):  # θ is 1-D here
         k = int(np.argmin(legs))
         if min(legs[k], plate) < -_TOUCH_RTOL * size:
             raise RuntimeError(f"collision limits: overlap at theta = {th!r} with no touch before it")

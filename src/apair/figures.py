@@ -9,15 +9,25 @@ Every function writes a new file and refuses to replace an existing one unless o
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
+from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from . import collisions as C
 from .files import target, write
 
+if TYPE_CHECKING:
+    from mpl_toolkits.mplot3d import Axes3D
 
-def figure():
+    from ._typing import WorkspaceLike
+    from .pair import APair
+
+
+def figure() -> ModuleType:
     """matplotlib.pyplot with the Agg backend (no display needed)."""
     import matplotlib
 
@@ -27,7 +37,7 @@ def figure():
     return plt
 
 
-def clearance(pair, path, overwrite: bool = False, samples: int = 2001) -> Path:
+def clearance(pair: APair, path: str | os.PathLike[str], overwrite: bool = False, samples: int = 2001) -> Path:
     """Clearance against θ: the closest two legs (segment distance − 2·leg_radius) and the plates
     (d − thickness), with the collision limits marked; θ spans the limits and a margin beyond."""
     p = target(path, overwrite)
@@ -67,7 +77,9 @@ def clearance(pair, path, overwrite: bool = False, samples: int = 2001) -> Path:
     return p
 
 
-def workspace(ws, path, overwrite: bool = False, max_points: int = 20_000) -> Path:
+def workspace(
+    ws: WorkspaceLike, path: str | os.PathLike[str], overwrite: bool = False, max_points: int = 20_000
+) -> Path:
     """A 3D view of the sampled end-effector origins (a random subset) and three cross-sections
     (slabs one voxel thick through the centre of the boundary), with the volume and its error."""
     p = target(path, overwrite)
@@ -103,7 +115,7 @@ def workspace(ws, path, overwrite: bool = False, max_points: int = 20_000) -> Pa
     return p
 
 
-def section(ws, axis: int):
+def section(ws: WorkspaceLike, axis: int) -> tuple[float, NDArray[np.bool_], NDArray[np.bool_]]:
     """The cross-section of a workspace normal to `axis` through the centre of its boundary: the
     layer of voxel centres nearest that centre (they lie on a lattice the centre may fall half-way
     between), and masks of the samples within half a voxel of it and of its boundary voxels."""
@@ -114,7 +126,7 @@ def section(ws, axis: int):
     return float(layer), slab, edge
 
 
-def axes_3d(ax, pts) -> float:
+def axes_3d(ax: Axes3D, pts: NDArray[np.float64]) -> float:
     """Equal scale on all three axes around the points, labelled with units, readable ticks;
     returns the half-extent [m]."""
     from matplotlib.ticker import MaxNLocator
@@ -130,7 +142,7 @@ def axes_3d(ax, pts) -> float:
     return extent
 
 
-def _equal_3d(ax, pts) -> float:
+def _equal_3d(ax: Axes3D, pts: NDArray[np.float64]) -> float:
     """Limits of one common span around the points (a margin of 10 %); returns the half-span."""
     c = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
     r = 0.55 * max(float(np.max(pts.max(axis=0) - pts.min(axis=0))), 1e-3)

@@ -13,6 +13,7 @@ import hashlib
 import os
 import shutil
 import tempfile
+from collections.abc import Callable
 from functools import cache
 from importlib import resources
 from pathlib import Path
@@ -20,7 +21,7 @@ from pathlib import Path
 from ._version import __version__
 
 
-def target(path, overwrite: bool, suffix: str = ".png") -> Path:
+def target(path: str | os.PathLike[str], overwrite: bool, suffix: str = ".png") -> Path:
     """The file a picture goes to, checked before any work: `suffix` is added when the name has
     none (so the file checked is the file written), a folder is refused, and so is an existing
     file or any symlink (dangling ones too) unless overwrite=True."""
@@ -40,19 +41,19 @@ def target(path, overwrite: bool, suffix: str = ".png") -> Path:
     return p
 
 
-def write_text(path, text: str, overwrite: bool, suffix: str) -> Path:
+def write_text(path: str | os.PathLike[str], text: str, overwrite: bool, suffix: str) -> Path:
     """Text (a MuJoCo model, a viewer page) to path by the rules of the pictures: `suffix` added
     where the name has none; an existing file only with overwrite=True."""
     p = target(path, overwrite, suffix)
 
-    def save(tmp):
+    def save(tmp: str) -> None:
         with open(tmp, "w", encoding="utf-8") as f:
             f.write(text)
 
     return write(p, overwrite, save)
 
 
-def write(p: Path, overwrite: bool, save) -> Path:
+def write(p: Path, overwrite: bool, save: Callable[[str], object]) -> Path:
     """save(tmp) writes the picture to a new file beside p, which then becomes p: copied into a
     file created exclusively (what appeared in between is never replaced), or, with overwrite,
     renamed over p (a symlink is replaced itself; what it pointed to is never written)."""

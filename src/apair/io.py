@@ -25,9 +25,12 @@ from __future__ import annotations
 import math
 import os
 import tomllib
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .chain import AChain
 from .link import Link
@@ -42,7 +45,7 @@ _DH_KEYS = {"a", "alpha", "alpha_deg", "offset", "theta_offset", "theta_offset_d
 _LINK_KEYS = {"mass", "com", "inertia"}
 
 
-def _numbers(where: str, v, shapes):
+def _numbers(where: str, v: object, shapes: Sequence[tuple[int, ...]]) -> NDArray[np.float64]:
     try:
         arr = np.asarray(v, dtype=object)
     except ValueError:  # ragged nesting
@@ -52,7 +55,7 @@ def _numbers(where: str, v, shapes):
     return np.array([_number(where, x) for x in arr.flat]).reshape(arr.shape)
 
 
-def _link(w: str, j: dict) -> Link:
+def _link(w: str, j: dict[str, Any]) -> Link:
     mass = _number(f"{w}.mass", j.get("mass", 0.0))
     com = _numbers(f"{w}.com", j.get("com", [0.0, 0.0, 0.0]), [(3,)])
     I = _numbers(f"{w}.inertia", j.get("inertia", [0.0, 0.0, 0.0]), [(3,), (6,), (3, 3)])
@@ -67,7 +70,7 @@ def _link(w: str, j: dict) -> Link:
         raise ValueError(f"{w}.{exc}") from None
 
 
-def _angle(where: str, j: dict, key: str, default=None):
+def _angle(where: str, j: dict[str, Any], key: str, default: float | None = None) -> float:
     if key in j and f"{key}_deg" in j:
         raise ValueError(f"{where}: give {key} or {key}_deg, not both")
     if f"{key}_deg" in j:
@@ -81,7 +84,7 @@ def _angle(where: str, j: dict, key: str, default=None):
     return default
 
 
-def _limits(where: str, j: dict, pair: APair):
+def _limits(where: str, j: dict[str, Any], pair: APair) -> tuple[float, float] | None:
     """A joint's explicit (lo, hi) in radians, or None; checked against the pair's collision-free
     range here, so that the message uses the file's key and units."""
     if "limits" in j and "limits_deg" in j:
@@ -101,7 +104,7 @@ def _limits(where: str, j: dict, pair: APair):
     return None
 
 
-def _number(where: str, v):
+def _number(where: str, v: object) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise ValueError(f"{where}: expected a number, got {_short(v)}")
     try:
@@ -113,13 +116,13 @@ def _number(where: str, v):
     return x
 
 
-def _short(v, limit: int = 60) -> str:
+def _short(v: object, limit: int = 60) -> str:
     """repr(v), cut to `limit` characters (a value in an error message, not a dump)."""
     text = repr(v)
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def chain_from_dict(data: dict, where: str = "chain") -> AChain:
+def chain_from_dict(data: dict[str, Any], where: str = "chain") -> AChain:
     """Build an AChain from the parsed TOML document."""
     unknown = set(data) - {"name", "joint", "description", "gravity"}
     if unknown:
@@ -168,7 +171,7 @@ def chain_from_dict(data: dict, where: str = "chain") -> AChain:
 MAX_FILE_BYTES = 16 * 2**20  # a chain file is a few kB; anything this large is not one
 
 
-def load(path) -> AChain:
+def load(path: str | os.PathLike[str]) -> AChain:
     """Read a chain from a TOML file (UTF-8, a byte-order mark allowed)."""
     if not isinstance(path, (str, os.PathLike)):
         raise ValueError(f"path: expected a file name, got {_short(path)}")

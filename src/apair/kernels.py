@@ -14,24 +14,38 @@ import importlib
 import json
 import os
 import warnings
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from functools import cache
 from importlib import resources
+from types import ModuleType
+from typing import Any, Protocol, TypedDict
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 _BACKENDS = ("c", "numpy")
-_state = {"backend": None, "warned": False, "resolved": None}
+
+
+class _State(TypedDict):
+    backend: str | None  # the explicit choice (set_backend)
+    warned: bool  # the missing extension has been reported
+    resolved: str | None  # the backend in use, None until the next kernel call
+
+
+_state: _State = {"backend": None, "warned": False, "resolved": None}
 
 
 @cache
-def manifest() -> dict:
+def manifest() -> dict[str, Any]:
     """Names, inputs, outputs and op counts of every generated kernel."""
-    return json.loads(resources.files("apair.generated").joinpath("manifest.json").read_text())
+    data: dict[str, Any] = json.loads(resources.files("apair.generated").joinpath("manifest.json").read_text())
+    return data
 
 
 @cache
-def _native():
-    """The extension module with the compiled kernels, or None (with the reason)."""
+def _native() -> tuple[Any, str | None]:
+    """The extension module with the compiled kernels, or None (with the reason). Any: the module is
+    untyped (a C extension)."""
     try:
         module = importlib.import_module("apair._native")
     except ImportError as exc:
@@ -51,13 +65,13 @@ def c_available() -> bool:
     return _native()[0] is not None
 
 
-def native_module():
+def native_module() -> tuple[ModuleType | None, str | None]:
     """(apair._native, None) where the compiled C kernels are installed, else (None, why not): for
     the code that calls the extension's own functions whatever the backend (AChain.ik_local)."""
     return _native()
 
 
-def native_in_use():
+def native_in_use() -> ModuleType | None:
     """apair._native where the C backend is in use, else None: the inverse kinematics' C steps,
     each with a NumPy twin that serves where this is None."""
     return _native()[0] if backend() == "c" else None
@@ -109,13 +123,13 @@ def _resolve_backend() -> str:
 
 
 @cache
-def _c_table(native) -> dict[str, int]:
+def _c_table(native: ModuleType) -> dict[str, int]:
     """Kernel name → registry index of the extension module, built whole before it is returned
     (threads calling for the first time never see a half-filled table)."""
     return {n: i for i, n in enumerate(native.names())}
 
 
-def _c_index(native, name: str) -> int:
+def _c_index(native: ModuleType, name: str) -> int:
     """The registry index of kernel `name` in the extension module."""
     try:
         return _c_table(native)[name]
@@ -124,13 +138,14 @@ def _c_index(native, name: str) -> int:
 
 
 @cache
-def _numpy_function(name: str):
+def _numpy_function(name: str) -> Callable[..., Any]:
     from apair.generated.numpy import KERNELS
 
-    return KERNELS[name]
+    function: Callable[..., Any] = KERNELS[name]
+    return function
 
 
-def _canonical(name: str, inputs) -> list[np.ndarray]:
+def _canonical(name: str, inputs: Sequence[ArrayLike]) -> list[NDArray[np.float64]]:
     """The inputs as float64 arrays (native byte order, aligned, C-contiguous) with one common
     batch shape (or none)."""
     spec = _input_spec(name, inputs)
@@ -146,15 +161,15 @@ def _canonical(name: str, inputs) -> list[np.ndarray]:
     ]
 
 
-def _input_spec(name: str, inputs) -> list[dict]:
+def _input_spec(name: str, inputs: Sequence[ArrayLike]) -> list[dict[str, Any]]:
     """The manifest's input list of kernel `name`, checked against the number of inputs given."""
-    spec = manifest()["kernels"][name]["inputs"]
+    spec: list[dict[str, Any]] = manifest()["kernels"][name]["inputs"]
     if len(inputs) != len(spec):
         raise TypeError(f"{name}: expected {len(spec)} inputs, got {len(inputs)}")
     return spec
 
 
-def _float64(kernel: str, arg: str, x) -> np.ndarray:
+def _float64(kernel: str, arg: str, x: ArrayLike) -> NDArray[np.float64]:
     """x as a native-endian float64 array; complex, boolean or non-numeric input is refused (a
     silent cast would drop imaginary parts or turn True into 1.0)."""
     arr = np.asarray(x)
@@ -163,32 +178,46 @@ def _float64(kernel: str, arg: str, x) -> np.ndarray:
     return arr.astype(np.float64, copy=False)
 
 
-def call(name: str, *inputs) -> list[np.ndarray]:
+def call(name: str, *inputs: ArrayLike) -> list[NDArray[np.float64]]:
     """Evaluate kernel `name`; inputs are float64 arrays with the kernel's trailing shapes."""
     if backend() == "c":
         native = _native()[0]
         index = _c_index(native, name)
-        out = native.call(index, *inputs)
+        out: list[NDArray[np.float64]] | None = native.call(index, *inputs)
         if out is None:  # some input needs converting or broadcasting first
             out = native.call(index, *_canonical(name, inputs))
             if out is None:
                 raise ValueError(f"{name}: the inputs do not fit the kernel's shapes after broadcasting")
         return out
     spec = _input_spec(name, inputs)
-    inputs = [_float64(name, a["name"], x) for x, a in zip(inputs, spec)]
-    out = _numpy_function(name)(*inputs)
-    return list(out) if isinstance(out, tuple) else [out]
+    arrays = [_float64(name, a["name"], x) for x, a in zip(inputs, spec)]
+    result = _numpy_function(name)(*arrays)
+    return list(result) if isinstance(result, tuple) else [result]
+
+
+class FastPath(Protocol):
+    """A chain's native fast path (`native_chain`)."""
+
+    def call(self, method: int, *inputs: ArrayLike) -> NDArray[np.float64] | None: ...
 
 
 class _NoFastPath:
     """The stand-in for a chain's native fast path where the C kernels are not installed."""
 
     @staticmethod
-    def call(method, *inputs):
+    def call(method: int, *inputs: ArrayLike) -> None:
         return None
 
 
-def native_chain(n: int, methods, laws, limits, design: dict, keep=None, table=None):
+def native_chain(
+    n: int,
+    methods: Iterable[tuple[str, bool]],
+    laws: Iterable[tuple[str, Sequence[float]]],
+    limits: Iterable[float],
+    design: Mapping[str, NDArray[np.float64]],
+    keep: object = None,
+    table: tuple[int, Sequence[str]] | None = None,
+) -> FastPath:
     """A chain's native fast path (apair._native.Chain): `methods` = [(kernel name, strict)],
     each a registry kernel, or with `table` = (address, names) an entry of a loaded registry of
     specialised kernels (AChain.specialise); `laws` = per joint (law kernel name, params), or []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _validate as V
 
@@ -14,7 +15,7 @@ class Link:
     frame i. The inertia must be symmetric and physically realisable: positive semi-definite with
     principal moments obeying the triangle inequality."""
 
-    def __init__(self, mass, com=(0.0, 0.0, 0.0), inertia=None):
+    def __init__(self, mass: ArrayLike, com: ArrayLike = (0.0, 0.0, 0.0), inertia: ArrayLike | None = None) -> None:
         self.mass = V.scalar("mass", mass, nonnegative=True)
         self.com = V.vector("com", com, 3)
         I = np.zeros((3, 3)) if inertia is None else V.real_array("inertia", inertia)
@@ -35,7 +36,7 @@ class Link:
     def __repr__(self) -> str:
         return f"Link({self.mass!r}, com={self.com.tolist()}, inertia={self.inertia.tolist()})"
 
-    def as_row(self) -> np.ndarray:
+    def as_row(self) -> NDArray[np.float64]:
         """(10,): mass, com, Ixx, Iyy, Izz, Ixy, Ixz, Iyz, the layout of the dynamics kernels."""
         I = self.inertia
         return np.array([self.mass, *self.com, I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])

@@ -27,13 +27,18 @@ of 1e-2 times that (kg m²); both change the dynamics by about MASSLESS.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from . import _validate as V
 from .kernels import call
+
+if TYPE_CHECKING:
+    from ._typing import ChainLike, PairLike
 
 MASSLESS = 1e-9  # mass given to a massless moving body, relative to the model's mass scale
 FLAT = 1e-9  # d below this × the pair's size: the legs are flat (d = 0), refused by `state`
@@ -46,18 +51,18 @@ SOLREF = (2 * TIMESTEP, 1.0)
 SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 
 
-def _f(x) -> str:
+def _f(x: ArrayLike) -> str:
     return " ".join(repr(float(v)) if v != 0 else "0" for v in np.atleast_1d(x))
 
 
-def _quat(R: np.ndarray) -> np.ndarray:
+def _quat(R: NDArray[np.float64]) -> NDArray[np.float64]:
     """MuJoCo's quaternion (w, x, y, z) of a rotation matrix."""
     x, y, z, w = Rotation.from_matrix(R).as_quat()
     q = np.array([w, x, y, z])
     return q if q[0] >= 0 else -q
 
 
-def _arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+def _arc(u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArray[np.float64]:
     """The smallest rotation taking the unit vector u to the unit vector v."""
     w = np.cross(u, v)
     c = float(u @ v)
@@ -70,7 +75,7 @@ def _arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     return Rotation.from_rotvec(w / s * math.atan2(s, c)).as_matrix()
 
 
-def _link_offset(chain, i: int) -> tuple[np.ndarray, np.ndarray]:
+def _link_offset(chain: ChainLike, i: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(R, p) of frame i in pair i's platform frame, Rz(φ_i) Tz(c_i) Tx(a_i) Rx(α_i): the joint
     transform kernel fk1 at θ = 0, d = 0."""
     law = call("law_revolute", [0.0])[0]
@@ -78,7 +83,7 @@ def _link_offset(chain, i: int) -> tuple[np.ndarray, np.ndarray]:
     return T[:3, :3], T[:3, 3]
 
 
-def _reference_legs(pair):
+def _reference_legs(pair: PairLike) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The legs at θ = 0 (the model's reference), in the pair's base frame: base points (6, 3),
     lengths (6,), and each leg body's reference frame (6, 3, 3), z along the leg."""
     pts = pair.leg_endpoints(0.0)
@@ -88,7 +93,7 @@ def _reference_legs(pair):
     return pts[:, 0], length, frames
 
 
-def _check_q(chain, q) -> np.ndarray:
+def _check_q(chain: ChainLike, q: ArrayLike | None) -> NDArray[np.float64]:
     if q is None:
         return np.zeros(chain.n)
     q = V.real_array("q", q)
@@ -98,7 +103,9 @@ def _check_q(chain, q) -> np.ndarray:
     return q
 
 
-def state(chain, q, qd=None) -> tuple[np.ndarray, np.ndarray]:
+def state(
+    chain: ChainLike, q: ArrayLike | None, qd: ArrayLike | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(qpos, qvel) of the model of `to_mjcf` at joint angles q (n,) and rates qd (n,), legs and
     slides included, loops closed, in the model's joint order (`joint_order`)."""
     q = _check_q(chain, q)
@@ -134,19 +141,19 @@ def state(chain, q, qd=None) -> tuple[np.ndarray, np.ndarray]:
     return np.array(qpos), np.array(qvel)
 
 
-def _mass_scale(chain) -> float:
+def _mass_scale(chain: ChainLike) -> float:
     masses = [lk.mass for lk in chain.links] + [p.leg_mass for p in chain.pairs if p.kind != "revolute"]
     return max([m for m in masses if m > 0], default=1.0)
 
 
-def _size(chain, i: int) -> float:
+def _size(chain: ChainLike, i: int) -> float:
     p = chain.pairs[i]
     if p.kind != "revolute":
         return max(p.base_radius, p.platform_radius)
     return max(0.02, 0.1 * max(np.abs(chain.a).max(), np.abs(chain.offset).max(), 0.1))
 
 
-def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) -> str:
+def to_mjcf(chain: ChainLike, q: ArrayLike | None = None, name: str = "apair chain", collisions: bool = False) -> str:
     """The MJCF text of the chain's mechanism (see the module's docstring); keyframe 0 is q
     (default: all zero), legs and loops consistent."""
     q = _check_q(chain, q)
@@ -156,7 +163,9 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
     assets, out = [], []
     qpos, _ = state(chain, q)
 
-    def inertial(indent, mass, pos, R, inertia):
+    def inertial(
+        indent: str, mass: float, pos: NDArray[np.float64], R: NDArray[np.float64], inertia: NDArray[np.float64]
+    ) -> None:
         """A link's inertial in its body's frame; a massless link, or a singular inertia (a point
         or a rod), gets the MASSLESS floor (MuJoCo needs positive mass and inertia)."""
         floor = tiny * 1e-2  # [kg m²]: the massless mass on a 0.1 m radius
@@ -168,7 +177,9 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
         full = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
         out.append(f'{indent}<inertial pos="{_f(pos)}" mass="{_f(mass)}" fullinertia="{_f(full)}"/>')
 
-    def plate(indent, label, radius, angle0, z=0.0, thick=None):
+    def plate(
+        indent: str, label: str, radius: float, angle0: float, z: float = 0.0, thick: float | None = None
+    ) -> None:
         """A triangle (circumradius `radius`, vertex 0 at polar angle angle0) as a thin prism mesh."""
         t = thick if thick else 0.02 * radius
         ang = angle0 + 2 * np.pi * np.arange(3) / 3
@@ -177,7 +188,14 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
         assets.append(f'    <mesh name="{label}" vertex="{_f(np.concatenate([top, bot]).ravel())}"/>')
         out.append(f'{indent}<geom name="{label}" type="mesh" mesh="{label}" {col} rgba="0.55 0.6 0.7 0.6"/>')
 
-    def rod(indent, label, a, b, radius, rgba="0.75 0.55 0.3 1"):
+    def rod(
+        indent: str,
+        label: str,
+        a: NDArray[np.float64],
+        b: NDArray[np.float64],
+        radius: float,
+        rgba: str = "0.75 0.55 0.3 1",
+    ) -> None:
         if np.linalg.norm(np.asarray(b) - a) < 1e-12:
             return
         out.append(
@@ -232,7 +250,7 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
         ind = indent + "  "
         out.append(f'{ind}<joint name="pair{n1}_theta" type="hinge" axis="0 0 1"/>')
         if pair.kind != "revolute":
-            top = float(max(pair.translation(np.linspace(*pair.motion_range(), 721)).max(), h0))
+            top = float(max(np.max(pair.translation(np.linspace(*pair.motion_range(), 721))), h0))
             out.append(
                 f'{ind}<joint name="pair{n1}_d" type="slide" axis="0 0 1" ref="{_f(h0)}" range="0 {_f(2 * top)}"/>'
             )
@@ -293,7 +311,7 @@ def to_mjcf(chain, q=None, name: str = "apair chain", collisions: bool = False) 
     return "\n".join(lines)
 
 
-def joint_order(chain) -> list[str]:
+def joint_order(chain: ChainLike) -> list[str]:
     """The names of the model's joints in qpos order (legs before their link's hinge and slide)."""
     names = []
     for i, pair in enumerate(chain.pairs):

@@ -7,11 +7,17 @@ of derivations/apair_pair.py; this module only validates and dispatches.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, cast, overload
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _validate as V
 from .kernels import call
+
+if TYPE_CHECKING:
+    from .collisions import CollisionLimits
+    from .link import Link
 
 KINDS = ("sinusoidal", "general", "revolute")
 _SINUSOIDAL_RTOL = 1e-12  # |a - b| <= this * b: the leg length is the sinusoidal one
@@ -20,7 +26,7 @@ _SINUSOIDAL_RTOL = 1e-12  # |a - b| <= this * b: the leg length is the sinusoida
 LENGTH_RANGE = (1e-150, 1e150)  # [m]: lengths whose squares and products are normal doubles
 
 
-def _length(name: str, value, positive: bool = False) -> float:
+def _length(name: str, value: ArrayLike, positive: bool = False) -> float:
     """A length [m] inside LENGTH_RANGE (0 allowed unless positive): outside it the pair's
     constants (L², r_b·r_p) overflow or underflow and no finite answer exists."""
     x = V.scalar(name, value, positive=positive, nonnegative=True)
@@ -40,13 +46,21 @@ class APair:
     thickness the plates (slabs about the planes of the leg end points; used by collisions).
     """
 
-    def __init__(self, base_radius, platform_radius, leg_length=None, leg_mass=0.0, leg_radius=0.0, thickness=0.0):
+    def __init__(
+        self,
+        base_radius: ArrayLike,
+        platform_radius: ArrayLike,
+        leg_length: ArrayLike | None = None,
+        leg_mass: ArrayLike = 0.0,
+        leg_radius: ArrayLike = 0.0,
+        thickness: ArrayLike = 0.0,
+    ) -> None:
         r_b = _length("base_radius", base_radius, positive=True)
         r_p = _length("platform_radius", platform_radius, positive=True)
         self.leg_mass = V.scalar("leg_mass", leg_mass, nonnegative=True)
         self.leg_radius = _length("leg_radius", leg_radius)
         self.thickness = _length("thickness", thickness)
-        self._limits = None
+        self._limits: CollisionLimits | None = None
         self.base_radius, self.platform_radius = r_b, r_p
         radii = np.array([r_b, r_p])
         if leg_length is None:
@@ -64,9 +78,9 @@ class APair:
             L2 = math.sqrt(L2_sq)
             self.kind = "sinusoidal" if abs(a - b) <= _SINUSOIDAL_RTOL * b else "general"
             h = math.sqrt(2 * b) if self.kind == "sinusoidal" else None
-        self._L = (float(L1), float(L2))
+        self._L: tuple[float, float] | None = (float(L1), float(L2))
         self.a, self.b = float(a), float(b)
-        self._h = float(h) if h is not None else None
+        self._h: float | None = float(h) if h is not None else None
 
     @classmethod
     def revolute(cls) -> APair:
@@ -84,7 +98,7 @@ class APair:
     def __repr__(self) -> str:
         if self.kind == "revolute":
             return "APair.revolute()"
-        extra = "" if self.kind == "sinusoidal" else f", leg_length={self._L[0]!r}"
+        extra = "" if self.kind == "sinusoidal" else f", leg_length={cast(tuple[float, float], self._L)[0]!r}"
         for key in ("leg_mass", "leg_radius", "thickness"):  # every parameter off its default
             if getattr(self, key) != 0.0:
                 extra += f", {key}={getattr(self, key)!r}"
@@ -98,7 +112,7 @@ class APair:
         return math.sqrt(self.a + self.b) - math.sqrt(max(self.a - self.b, 0.0))
 
     @property
-    def leg_lengths(self) -> np.ndarray:
+    def leg_lengths(self) -> NDArray[np.float64]:
         """(6,): three legs of length L1 (base vertices), three of length L2; empty for an R-pair."""
         if self._L is None:
             return np.zeros(0)
@@ -123,7 +137,7 @@ class APair:
         c, s = math.cos(theta / 2), math.sin(theta / 2)
         return self.a + self.b * (c * c - s * s)
 
-    def collision_limits(self):
+    def collision_limits(self) -> CollisionLimits:
         """(theta_min, theta_max, what touches first): the collision-free range of θ around 0, where
         the legs (cylinders of radius leg_radius) or the plates (thickness) first touch, found by
         exact root isolation on the derived contact polynomials (apair.collisions). Infinite for an
@@ -142,7 +156,7 @@ class APair:
             lo, hi = max(lo, -self.theta_limit), min(hi, self.theta_limit)
         return lo, hi
 
-    def _theta(self, theta, name="theta") -> np.ndarray:
+    def _theta(self, theta: ArrayLike, name: str = "theta") -> NDArray[np.float64]:
         """θ validated; for a pair with a limited range, angles past the range end by no more than
         rounding (a + b cos θ ≥ −4ε(|a| + b)) are put on it, anything further is refused."""
         th = V.real_array(name, theta)
@@ -158,10 +172,10 @@ class APair:
                         f"e.g. {th[far].flat[0]!r}"
                     )
                 turns = 2 * np.pi * np.round(th / (2 * np.pi))
-                th = np.where(bad, turns + np.copysign(self.theta_limit, th - turns), th)
+                th = np.where(bad, turns + np.copysign(cast(float, self.theta_limit), th - turns), th)
         return th
 
-    def law(self, theta, name="theta") -> np.ndarray:
+    def law(self, theta: ArrayLike, name: str = "theta") -> NDArray[np.float64]:
         """(..., 3): d(θ), d'(θ), d''(θ); broadcasts over θ."""
         return self._law(self._theta(theta, name))[..., 2:]
 
@@ -172,20 +186,31 @@ class APair:
         if self.kind == "revolute":
             return "law_revolute", ()
         if self.kind == "sinusoidal":
-            return "law_sinusoidal", (self._h,)
+            return "law_sinusoidal", (cast(float, self._h),)
         return "law_general", (self.a, self.b)
 
-    def _law(self, th: np.ndarray) -> np.ndarray:
+    def _law(self, th: NDArray[np.float64]) -> NDArray[np.float64]:
         """(..., 5): the law values of validated angles."""
         kernel, params = self.law_kernel
         return call(kernel, th[..., None], *([x] for x in params))[0]
 
-    def translation(self, theta) -> np.ndarray:
+    @overload
+    def translation(self, theta: float) -> float: ...
+    @overload
+    def translation(self, theta: ArrayLike) -> float | NDArray[np.float64]: ...
+    def translation(self, theta: ArrayLike) -> float | NDArray[np.float64]:
         """d(θ) [m], broadcasting over θ (a float for a scalar θ)."""
         d = self.law(theta)[..., 0]
         return float(d) if d.ndim == 0 else d
 
-    def dynamics(self, theta, qd=0.0, qdd=0.0, platform=None, g=9.81) -> np.ndarray:
+    def dynamics(
+        self,
+        theta: ArrayLike,
+        qd: ArrayLike = 0.0,
+        qdd: ArrayLike = 0.0,
+        platform: Link | None = None,
+        g: ArrayLike = 9.81,
+    ) -> NDArray[np.float64]:
         """(..., 4): (τ, J, J'/2, G) of this pair alone with a vertical axis and gravity g along −z:
         τ = J(θ)θ'' + ½J'(θ)θ'² + G(θ). `platform` is a Link in the platform frame (default: none),
         the legs are this pair's. See `apair show apair_dynamics` for the closed forms."""
@@ -214,7 +239,7 @@ class APair:
         legs = np.array([self.leg_mass, self.base_radius, self.platform_radius])
         return call("pair_dynamics", th[..., None], qd[..., None], qdd[..., None], law, plat, legs, [g])[0]
 
-    def leg_endpoints(self, theta) -> np.ndarray:
+    def leg_endpoints(self, theta: ArrayLike) -> NDArray[np.float64]:
         """(..., 6, 2, 3): [base point, platform point] of each leg in the pair's base frame."""
         th = self._theta(theta)
         if self.kind == "revolute":

@@ -7,18 +7,30 @@ The pictures that need no chain (clearance, workspace) live in apair.figures and
 from __future__ import annotations
 
 import math
+import os
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .chain import AChain
 from .figures import axes_3d, clearance, figure, section, workspace
 from .files import target, write, write_text
 
+if TYPE_CHECKING:
+    from mpl_toolkits.mplot3d import Axes3D
+
+    from .pair import APair
+
+# a drawn line: start, end, and what it is ("link", "leg" or "plate")
+Segment = tuple[NDArray[np.float64], NDArray[np.float64], str]
+
 __all__ = ["chain_picture", "clearance", "pair_animation", "section", "segments", "workspace", "write_text"]
 
 
-def segments(chain, q) -> list[tuple[np.ndarray, np.ndarray, str]]:
+def segments(chain: AChain, q: ArrayLike) -> list[Segment]:
     """The chain at q as line segments (start, end, "link" | "leg" | "plate") in the base frame.
     A pair is drawn in its base frame (frame i−1 turned by φ_i): legs, base and platform triangles.
     Frame i is the fk kernel's pose of the chain's first i joints."""
@@ -42,14 +54,14 @@ def segments(chain, q) -> list[tuple[np.ndarray, np.ndarray, str]]:
     return out
 
 
-def _triangles(segs) -> list[np.ndarray]:
+def _triangles(segs: Sequence[Segment]) -> list[NDArray[np.float64]]:
     """The plates as filled triangles (3, 3) from a chain's segments: each A-pair's base and
     platform triangle (three edges each, one vertex at the start of each edge)."""
     starts = [a for a, _, kind in segs if kind == "plate"]
     return [np.stack(starts[k : k + 3]) for k in range(0, len(starts), 3)]
 
 
-def _draw(ax, chain, q, extent: float, segs=None):
+def _draw(ax: Axes3D, chain: AChain, q: ArrayLike, extent: float, segs: Sequence[Segment] | None = None) -> None:
     """Links (black), legs (blue, drawn as wide as their real radius where one is given), plates
     (filled orange triangles), the base (square) and the end effector (triangle, with its frame)."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
@@ -75,11 +87,11 @@ def _draw(ax, chain, q, extent: float, segs=None):
         ax.plot(*np.stack([T[:3, 3], T[:3, 3] + 0.15 * extent * axis]).T, color=colour, lw=1.2)
 
 
-def _scene_points(segs) -> np.ndarray:
+def _scene_points(segs: Sequence[Segment]) -> NDArray[np.float64]:
     return np.array([x for a, b, _ in segs for x in (a, b)] + [np.zeros(3)])
 
 
-def chain_picture(chain, q, path, overwrite: bool = False) -> Path:
+def chain_picture(chain: AChain, q: ArrayLike, path: str | os.PathLike[str], overwrite: bool = False) -> Path:
     """A 3D picture of the chain at q, fit for a paper: equal scale on all axes, labelled in
     metres; links (black), legs (blue, their real radius where given), plates (filled orange),
     the base (square) and the end effector (triangle, with its frame: x red, y green, z blue)."""
@@ -98,7 +110,7 @@ def chain_picture(chain, q, path, overwrite: bool = False) -> Path:
     return p
 
 
-def pair_animation(pair, path, frames: int = 48, overwrite: bool = False) -> Path:
+def pair_animation(pair: APair, path: str | os.PathLike[str], frames: int = 48, overwrite: bool = False) -> Path:
     """A GIF of one A-pair turning through its collision-free range and back (Pillow writer)."""
     from matplotlib.animation import FuncAnimation, PillowWriter
 
@@ -115,7 +127,7 @@ def pair_animation(pair, path, frames: int = 48, overwrite: bool = False) -> Pat
     fig = plt.figure(figsize=(5, 5))
     ax = fig.add_subplot(projection="3d")
 
-    def frame(k):
+    def frame(k: int) -> None:
         ax.cla()
         extent = axes_3d(ax, every)
         _draw(ax, chain, [angles[k]], extent)

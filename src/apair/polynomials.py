@@ -5,12 +5,14 @@ from __future__ import annotations
 import json
 from functools import cache
 from importlib import resources
+from importlib.resources.abc import Traversable
+from typing import Any
 
 import sympy as sp
 from sympy.parsing.sympy_parser import parse_expr
 
 
-def _dir():
+def _dir() -> Traversable:
     return resources.files("apair.generated").joinpath("polynomials")
 
 
@@ -20,7 +22,7 @@ def names() -> list[str]:
 
 
 @cache
-def raw(name: str) -> dict:
+def raw(name: str) -> dict[str, Any]:
     if name not in names():
         raise ValueError(f"name: no derived polynomial set {name!r}; known: {', '.join(names())}")
     return json.loads(_dir().joinpath(f"{name}.json").read_text())

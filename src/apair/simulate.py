@@ -11,11 +11,20 @@ itself ends) stops the run.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _validate as V
+
+if TYPE_CHECKING:
+    from ._typing import ChainLike
+
+# tau(t, q, qd) -> (n,): the torques as a function of the time and the state
+Torque = Callable[[float, NDArray[np.float64], NDArray[np.float64]], ArrayLike]
 
 
 @dataclass(frozen=True)
@@ -36,19 +45,30 @@ class LimitStop:
 class Trajectory:
     """States at the requested times: t (K,), q and qd (K, n), kinetic and potential energy (K,)."""
 
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    kinetic: np.ndarray
-    potential: np.ndarray
+    t: NDArray[np.float64]
+    q: NDArray[np.float64]
+    qd: NDArray[np.float64]
+    kinetic: NDArray[np.float64]
+    potential: NDArray[np.float64]
     stop: LimitStop | None = None  # the joint limit that ended the run, None if it ran to t[-1]
 
     @property
-    def energy(self) -> np.ndarray:
+    def energy(self) -> NDArray[np.float64]:
         return self.kinetic + self.potential
 
 
-def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP853", limits="stop") -> Trajectory:
+def simulate(
+    chain: ChainLike,
+    q0: ArrayLike,
+    qd0: ArrayLike,
+    t: ArrayLike,
+    tau: ArrayLike | Torque | None = None,
+    *,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    method: str = "DOP853",
+    limits: str = "stop",
+) -> Trajectory:
     from scipy.integrate import solve_ivp
 
     n = chain.n
@@ -70,15 +90,19 @@ def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP
                 f"q0: joint {i + 1} at {q0[i]:.6g} rad is outside its limits ({lo:.6g}, {hi:.6g}) rad"
                 + (" (limits='ignore' passes explicit and collision limits)" if limits == "stop" else "")
             )
+    torque: Torque
     if tau is None:
         torque = lambda _t, _q, _qd: np.zeros(n)
     elif callable(tau):
+        given = tau
 
-        def torque(tt, q, qd):
-            out = V.real_array("tau", tau(tt, q, qd))
+        def checked(tt: float, q: NDArray[np.float64], qd: NDArray[np.float64]) -> NDArray[np.float64]:
+            out = V.real_array("tau", given(tt, q, qd))
             if out.shape != (n,):
                 raise ValueError(f"tau: the callable must return shape ({n},), got {out.shape}")
             return out
+
+        torque = checked
     else:
         const = V.vector("tau", tau, n)
         torque = lambda _t, _q, _qd: const
@@ -87,26 +111,22 @@ def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP
     inside = bounds.copy()
     ends = [i for i, p in enumerate(chain.pairs) if p.theta_limit is not None]
     for i in ends:
-        lim = chain.pairs[i].theta_limit * (1 - 1e-9)
+        lim = cast(float, chain.pairs[i].theta_limit) * (1 - 1e-9)  # ends: the pairs with a limit
         inside[i] = max(inside[i, 0], -lim), min(inside[i, 1], lim)
 
-    def rhs(tt, y):
+    def rhs(tt: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         q, qd = y[:n], y[n:]
         if ends:
             q = q.copy()
             q[ends] = np.clip(q[ends], inside[ends, 0], inside[ends, 1])
         return np.concatenate([qd, chain.forward_dynamics(q, qd, torque(tt, y[:n], qd))])
 
-    events, which = [], []
+    events: list[_LimitEvent] = []
+    which: list[tuple[int, str, float]] = []
     for i, (lo, hi) in enumerate(inside):
         for side, value, sign in (("lower", lo, 1.0), ("upper", hi, -1.0)):
             if np.isfinite(value):
-
-                def event(_t, y, i=i, value=value, sign=sign):
-                    return sign * (y[i] - value)
-
-                event.terminal, event.direction = True, -1
-                events.append(event)
+                events.append(_LimitEvent(i, value, sign))
                 which.append((i, side, bounds[i, 0 if side == "lower" else 1]))
     sol = solve_ivp(
         rhs,
@@ -133,7 +153,21 @@ def simulate(chain, q0, qd0, t, tau=None, *, rtol=1e-10, atol=1e-12, method="DOP
     return Trajectory(t=times, q=q, qd=qd, kinetic=E[:, 0], potential=E[:, 1], stop=stop)
 
 
-def _bounds(chain, limits: str) -> np.ndarray:
+class _LimitEvent:
+    """solve_ivp's event of joint i reaching `value` from inside (sign: +1 the lower limit, −1 the
+    upper one): terminal, in the falling direction."""
+
+    terminal = True
+    direction = -1
+
+    def __init__(self, i: int, value: float, sign: float) -> None:
+        self.i, self.value, self.sign = i, value, sign
+
+    def __call__(self, _t: float, y: NDArray[np.float64]) -> float:
+        return self.sign * (y[self.i] - self.value)
+
+
+def _bounds(chain: ChainLike, limits: str) -> NDArray[np.float64]:
     """(n, 2) the limits that stop a run: all hard limits, or only the range ends of general pairs."""
     if limits == "stop":
         return chain.hard_limits()

@@ -11,13 +11,22 @@ from __future__ import annotations
 
 import hashlib
 import keyword
+import os
 import re
+from collections.abc import Iterable, Sequence
 from importlib import resources
 from pathlib import Path
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .files import cache_root, toolkit_digest
+
+if TYPE_CHECKING:
+    from ._typing import ChainLike
+    from .kernels import FastPath
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _C_KEYWORDS = frozenset(
@@ -28,7 +37,7 @@ _C_KEYWORDS = frozenset(
 SELFTEST_STATES = 4
 
 
-def _toolkit():
+def _toolkit() -> tuple[ModuleType, ModuleType]:
     """derivations.specialised and codegen.emitter, as installed with the runtime."""
     from .codegen import emitter
     from .derivations import specialised
@@ -36,7 +45,7 @@ def _toolkit():
     return specialised, emitter
 
 
-def design_of(chain):
+def design_of(chain: ChainLike) -> Any:
     """The chain's constants as derivations.specialised.Design (plain numbers)."""
     specialised, _ = _toolkit()
     return specialised.Design(
@@ -49,7 +58,7 @@ def design_of(chain):
     )
 
 
-def content_hash(chain, kernels) -> str:
+def content_hash(chain: ChainLike, kernels: Iterable[str]) -> str:
     """16 hex digits identifying the generated code: the design, the kernels chosen, the toolkit."""
     h = hashlib.sha256(design_of(chain).canonical().encode())
     h.update((",".join(kernels) + "\0" + toolkit_digest()).encode())
@@ -68,7 +77,7 @@ def check_prefix(name: str) -> str:
     return name
 
 
-def prefix_from(path) -> str:
+def prefix_from(path: str | os.PathLike[str]) -> str:
     """The default prefix of a chain file: its name without .toml, made an identifier."""
     stem = re.sub(r"[^A-Za-z0-9_]", "_", Path(path).stem) or "chain"
     if stem[0].isdigit():
@@ -76,20 +85,20 @@ def prefix_from(path) -> str:
     return check_prefix(stem[:48])
 
 
-def check_kernels(kernels) -> tuple[str, ...]:
+def check_kernels(kernels: Iterable[str] | None) -> tuple[str, ...]:
     specialised, _ = _toolkit()
     if kernels is None:
         return tuple(specialised.KERNELS)
-    kernels = tuple(kernels)
-    unknown = [k for k in kernels if k not in specialised.KERNELS]
-    if unknown or not kernels:
+    chosen = tuple(kernels)
+    unknown = [k for k in chosen if k not in specialised.KERNELS]
+    if unknown or not chosen:
         raise ValueError(
-            f"kernels: expected names from {', '.join(specialised.KERNELS)}, got {', '.join(kernels) or 'none'}"
+            f"kernels: expected names from {', '.join(specialised.KERNELS)}, got {', '.join(chosen) or 'none'}"
         )
-    return tuple(k for k in specialised.KERNELS if k in kernels)
+    return tuple(k for k in specialised.KERNELS if k in chosen)
 
 
-def lowered(chain, kernels) -> tuple[list, dict]:
+def lowered(chain: ChainLike, kernels: Iterable[str]) -> tuple[list[Any], dict[str, Any]]:
     """The chain's specialised kernels, derived and lowered (CSE, printed), and the parts they
     call by name."""
     specialised, emitter = _toolkit()
@@ -98,7 +107,7 @@ def lowered(chain, kernels) -> tuple[list, dict]:
     return [emitter.lower(s) for s in specs], parts
 
 
-def _states(chain, count: int, seed: int) -> dict[str, np.ndarray]:
+def _states(chain: ChainLike, count: int, seed: int) -> dict[str, NDArray[np.float64]]:
     """The self-test's states: q = 0, then random joint values well inside the limits; random qd,
     qdd, tau."""
     rng = np.random.default_rng(seed)
@@ -114,7 +123,9 @@ def _states(chain, count: int, seed: int) -> dict[str, np.ndarray]:
     }
 
 
-def references(chain, kernels: list, count: int = SELFTEST_STATES, seed: int = 0) -> list[dict]:
+def references(
+    chain: ChainLike, kernels: list[Any], count: int = SELFTEST_STATES, seed: int = 0
+) -> list[dict[str, Any]]:
     """Inputs and generic-runtime outputs of each kernel on the self-test's states; a kernel whose
     reference cannot be computed (forward dynamics of a chain without inertia) is left out."""
     states = _states(chain, count, seed)
@@ -136,7 +147,7 @@ def references(chain, kernels: list, count: int = SELFTEST_STATES, seed: int = 0
     return tests
 
 
-def _describe(chain) -> tuple[str, str]:
+def _describe(chain: ChainLike) -> tuple[str, str]:
     joints = ", ".join(f"{i + 1} {p.kind}" for i, p in enumerate(chain.pairs))
     ranges = "; ".join(
         f"|q_{i + 1}| <= {p.theta_limit!r} (mod 2 pi)" for i, p in enumerate(chain.pairs) if p.theta_limit is not None
@@ -144,15 +155,22 @@ def _describe(chain) -> tuple[str, str]:
     return joints, ranges
 
 
-def render(chain, name: str, origin: str, kernels=None, title: str | None = None, code=None) -> dict[str, str]:
+def render(
+    chain: ChainLike,
+    name: str,
+    origin: str,
+    kernels: Iterable[str] | None = None,
+    title: str | None = None,
+    code: tuple[list[Any], dict[str, Any]] | None = None,
+) -> dict[str, str]:
     """{file name: text} of the chain's code (see codegen.emitter.Emitter.render_chain); `code`:
     the lowered kernels if already at hand."""
     _, emitter = _toolkit()
     name = check_prefix(name)
     kernels = check_kernels(kernels)
-    code, parts = code or lowered(chain, kernels)
-    tests = references(chain, code)
-    by_name = {k.name: k for k in code}
+    lowered_kernels, parts = code or lowered(chain, kernels)
+    tests = references(chain, lowered_kernels)
+    by_name = {k.name: k for k in lowered_kernels}
     joints, ranges = _describe(chain)
     # the title goes into C comments, CMake and pkg-config strings: plain characters only
     title = " ".join(re.sub(r"[^\w .,:()+-]", " ", title or f"{chain.n}-joint chain").split())[:80]
@@ -165,11 +183,19 @@ def render(chain, name: str, origin: str, kernels=None, title: str | None = None
         "n": chain.n,
         "hash": content_hash(chain, kernels),
     }
-    return emitter.Emitter().render_chain(code, parts, name, meta, [dict(t, kernel=by_name[t["name"]]) for t in tests])
+    return emitter.Emitter().render_chain(
+        lowered_kernels, parts, name, meta, [dict(t, kernel=by_name[t["name"]]) for t in tests]
+    )
 
 
 def write_code(
-    chain, out, name: str, origin: str, kernels=None, title: str | None = None, force: bool = False
+    chain: ChainLike,
+    out: str | os.PathLike[str],
+    name: str,
+    origin: str,
+    kernels: Iterable[str] | None = None,
+    title: str | None = None,
+    force: bool = False,
 ) -> list[str]:
     """Write the chain's code into the folder `out` (created if need be). A file there that an
     earlier run did not write (a user's own, a symbolic link) is refused unless `force`; stale
@@ -184,7 +210,7 @@ def write_code(
 
 
 # ------------------------------------------------------------------------------------ AChain.specialise
-_warned = set()
+_warned: set[str] = set()
 
 
 def _compiler() -> str | None:
@@ -203,11 +229,10 @@ def _warn_once(key: str, message: str) -> None:
         warnings.warn(message, RuntimeWarning, stacklevel=4)
 
 
-def build(chain, kernels=None) -> tuple[Path, str, tuple[str, ...]] | None:
+def build(chain: ChainLike, kernels: Iterable[str] | None = None) -> tuple[Path, str, tuple[str, ...]] | None:
     """The chain's specialised kernels compiled into a shared library in the cache (built on
     first use; the folder is named by the content hash, so a build of other code is never
     taken). Returns (library, symbol prefix, kernel names), or None without a C compiler."""
-    import os
     import subprocess
     import tempfile
 
@@ -265,7 +290,9 @@ def build(chain, kernels=None) -> tuple[Path, str, tuple[str, ...]] | None:
     return library, name, kernels
 
 
-def load(chain, methods, kernels=None):
+def load(
+    chain: ChainLike, methods: Sequence[tuple[str, bool]], kernels: Iterable[str] | None = None
+) -> FastPath | None:
     """The native fast path of the chain's specialised kernels (kernels.native_chain) for the
     chain's `methods` ((kernel family, strict) in the order of its fast path: apair.chain.METHODS)
     and the loaded library, or None (no compiler, or the C backend is not installed)."""

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 
-def normalise(study: np.ndarray) -> np.ndarray:
+def normalise(study: NDArray[np.float64]) -> NDArray[np.float64]:
     """Scale (..., 8) Study points so that x0² + x1² + x2² + x3² = 1 (the sign is kept)."""
     norm = np.linalg.norm(study[..., :4], axis=-1, keepdims=True)
     if np.any(norm == 0):
@@ -15,7 +17,7 @@ def normalise(study: np.ndarray) -> np.ndarray:
     return study / norm
 
 
-def to_matrix(study) -> np.ndarray:
+def to_matrix(study: ArrayLike) -> NDArray[np.float64]:
     """(..., 8) Study points -> (..., 4, 4) transforms: R from x, t = 2 y x̃ / |x|²."""
     s = np.asarray(study, dtype=np.float64)
     x, y = s[..., :4], s[..., 4:]
@@ -53,7 +55,7 @@ def to_matrix(study) -> np.ndarray:
     return T
 
 
-def _shepperd() -> tuple[np.ndarray, np.ndarray]:
+def _shepperd() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(C, D): the symmetric 4 × 4 matrix K = C·R + D whose rows are proportional to the quaternion
     of R, row k the best-conditioned where K_kk is largest (Shepperd): K_kk = 4 x_k²."""
     C, D = np.zeros((4, 4, 3, 3)), np.eye(4)
@@ -86,7 +88,7 @@ _HALF_T = np.array(
 _HALF_T_ROWS = np.ascontiguousarray(_HALF_T.transpose(1, 0, 2).reshape(3, 16))  # t ↦ Σ_a t_a L[i, a, b]
 
 
-def from_matrix(T) -> np.ndarray:
+def from_matrix(T: ArrayLike) -> NDArray[np.float64]:
     """(..., 4, 4) rigid transforms -> unit Study points (Shepperd's branch choice for x)."""
     T = np.asarray(T, dtype=np.float64)
     if T.shape == (4, 4):  # one pose: the same steps, with fewer array operations
@@ -104,7 +106,7 @@ def from_matrix(T) -> np.ndarray:
     return np.concatenate([x, y], -1)
 
 
-def qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def qmul(a: NDArray[Any], b: NDArray[Any]) -> NDArray[Any]:
     """Hamilton product of quaternions (..., 4), broadcasting (object arrays too)."""
     a0, a1, a2, a3 = np.moveaxis(a, -1, 0)
     b0, b1, b2, b3 = np.moveaxis(b, -1, 0)
@@ -119,7 +121,7 @@ def qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     )
 
 
-def multiply(p, q) -> np.ndarray:
+def multiply(p: ArrayLike, q: ArrayLike) -> NDArray[Any]:
     """Dual-quaternion product of (..., 8) Study points (broadcasting; real or complex):
     (x1 + εy1)(x2 + εy2) = x1x2 + ε(x1y2 + y1x2), the point of T1·T2."""
     p, q = np.asarray(p), np.asarray(q)
@@ -131,6 +133,6 @@ def multiply(p, q) -> np.ndarray:
 _CONJ = np.array([1.0, -1.0, -1.0, -1.0, 1.0, -1.0, -1.0, -1.0])
 
 
-def conjugate(p) -> np.ndarray:
+def conjugate(p: ArrayLike) -> NDArray[Any]:
     """(x̃, ỹ): projectively the inverse displacement of a point on the Study quadric."""
     return np.asarray(p) * _CONJ

@@ -20,16 +20,25 @@ from __future__ import annotations
 import itertools
 import math
 import random
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 import numpy as np
 import sympy as sp
+from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from ._typing import ChainLike
 
 VARS = sp.symbols("x0 x1 x2 x3 y0 y1 y2 y3", real=True)
 MAX_DENOMINATOR = 10**6
 RATIONAL_TOL = 1e-12
 PRIME = 2**31 - 1  # products of two residues fit in int64
+
+N = TypeVar("N", Fraction, float)  # the numbers of a design: exact rationals, or floating point
+Exponents = tuple[int, ...]  # of a monomial in x0..y3
 
 
 class Variety(list):
@@ -40,7 +49,7 @@ class Variety(list):
     `residual` the largest |F| on fresh unit-normalised poses, coefficients normalised to norm 1).
     """
 
-    def __init__(self, equations, **info):
+    def __init__(self, equations: Iterable[Any], **info: Any) -> None:
         super().__init__(equations)
         self.degree: int | None = info.get("degree")
         self.hilbert: dict = info.get("hilbert", {})
@@ -51,7 +60,7 @@ class Variety(list):
 
 
 # ----------------------------------------------------------------------------- exact dual quaternions
-def _qmul(a, b):
+def _qmul(a: Sequence[N], b: Sequence[N]) -> tuple[N, N, N, N]:
     return (
         a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
         a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
@@ -60,20 +69,20 @@ def _qmul(a, b):
     )
 
 
-def _smul(p, q):
+def _smul(p: Sequence[N], q: Sequence[N]) -> tuple[N, ...]:
     """Study product (x1 + εy1)(x2 + εy2) = x1x2 + ε(x1y2 + y1x2)."""
     x = _qmul(p[:4], q[:4])
     y1, y2 = _qmul(p[:4], q[4:]), _qmul(p[4:], q[:4])
     return x + tuple(s + t for s, t in zip(y1, y2))
 
 
-def _rot(axis, c, s, zero):
+def _rot(axis: int, c: N, s: N, zero: N) -> tuple[N, ...]:
     x = [c, zero, zero, zero]
     x[1 + axis] = s
     return tuple(x) + (zero,) * 4
 
 
-def _trans(axis, dist, one, zero):
+def _trans(axis: int, dist: N, one: N, zero: N) -> tuple[N, ...]:
     y = [zero] * 4
     y[1 + axis] = dist / 2
     return (one, zero, zero, zero) + tuple(y)
@@ -81,15 +90,16 @@ def _trans(axis, dist, one, zero):
 
 # ----------------------------------------------------------------------------- designs
 @dataclass
-class JointDesign:
-    """One joint: kind, amplitude h (sinusoidal), a, c and the half-angle pairs of α and φ."""
+class JointDesign(Generic[N]):
+    """One joint: kind, amplitude h (sinusoidal), a, c and the half-angle pairs of α and φ, in
+    rationals (an exact design) or floats."""
 
     kind: str
-    h: object
-    a: object
-    c: object
-    alpha: tuple
-    phi: tuple
+    h: N
+    a: N
+    c: N
+    alpha: tuple[N, N]
+    phi: tuple[N, N]
 
 
 def _rational(x: float) -> Fraction | None:
@@ -97,7 +107,7 @@ def _rational(x: float) -> Fraction | None:
     return f if abs(float(f) - x) <= RATIONAL_TOL * max(1.0, abs(x)) else None
 
 
-def _half_pair(angle: float):
+def _half_pair(angle: float) -> tuple[Fraction, Fraction] | None:
     """(cos, sin) of angle/2 up to a common factor, rational if tan(angle/2) (or its inverse) is."""
     c, s = math.cos(angle / 2), math.sin(angle / 2)
     if abs(c) >= abs(s):
@@ -107,41 +117,40 @@ def _half_pair(angle: float):
     return None if t is None else (t, Fraction(1))
 
 
-def designs(chain) -> tuple[list[JointDesign], bool]:
-    """Exact joint designs when every constant is rational and every pair rational; else floats."""
-    exact, out = True, []
+def designs(chain: ChainLike) -> tuple[list[JointDesign[Any]], bool]:
+    """Exact joint designs when every constant is rational and every pair rational; else floats
+    (JointDesign[Fraction] or JointDesign[float], as the flag says)."""
+    exact = True
+    exact_joints: list[JointDesign[Fraction]] = []
+    float_joints: list[JointDesign[float]] = []
     for i, p in enumerate(chain.pairs):
-        vals = {"a": chain.a[i], "c": chain.offset[i]}
+        a, c = chain.a[i], chain.offset[i]
         h = 0.0 if p.kind == "revolute" else p.amplitude
         if p.kind == "general":
             exact = False
-        rat = {k: _rational(float(v)) for k, v in vals.items()}
-        rat["h"] = _rational(h)
+        ra, rc, rh = _rational(float(a)), _rational(float(c)), _rational(h)
         al, ph = _half_pair(chain.alpha[i]), _half_pair(chain.theta_offset[i])
-        if any(v is None for v in rat.values()) or al is None or ph is None:
+        if ra is None or rc is None or rh is None or al is None or ph is None:
             exact = False
-        out.append((p, vals, h, rat, al, ph, i))
-    result = []
-    for p, vals, h, rat, al, ph, i in out:
-        if exact:
-            result.append(JointDesign(p.kind, rat["h"], rat["a"], rat["c"], al, ph))
         else:
-            result.append(
-                JointDesign(
-                    p.kind,
-                    h,
-                    vals["a"],
-                    vals["c"],
-                    (math.cos(chain.alpha[i] / 2), math.sin(chain.alpha[i] / 2)),
-                    (math.cos(chain.theta_offset[i] / 2), math.sin(chain.theta_offset[i] / 2)),
-                )
+            exact_joints.append(JointDesign(p.kind, rh, ra, rc, al, ph))
+        float_joints.append(
+            JointDesign(
+                p.kind,
+                h,
+                a,
+                c,
+                (math.cos(chain.alpha[i] / 2), math.sin(chain.alpha[i] / 2)),
+                (math.cos(chain.theta_offset[i] / 2), math.sin(chain.theta_offset[i] / 2)),
             )
-    return result, exact
+        )
+    return (exact_joints, True) if exact else (float_joints, False)
 
 
-def _pair_point_exact(j: JointDesign, u: Fraction):
+def _pair_point_exact(j: JointDesign[Fraction], u: Fraction) -> tuple[Fraction, ...]:
     """The joint's Study point at parameter u, exactly (polynomial in u, projective)."""
     one, zero = Fraction(1), Fraction(0)
+    P: tuple[Fraction, ...]
     if j.kind == "revolute":
         P = (one, zero, zero, u, zero, zero, zero, zero)  # u = tan(θ/2)
     else:
@@ -149,16 +158,16 @@ def _pair_point_exact(j: JointDesign, u: Fraction):
     return _constant_factors(j, P, one, zero)
 
 
-def _constant_factors(j, P, one, zero):
+def _constant_factors(j: JointDesign[N], P: Sequence[N], one: N, zero: N) -> tuple[N, ...]:
     left = _rot(2, j.phi[0], j.phi[1], zero)
     right = _smul(_smul(_trans(2, j.c, one, zero), _trans(0, j.a, one, zero)), _rot(0, j.alpha[0], j.alpha[1], zero))
     return _smul(_smul(left, P), right)
 
 
-_QUARTIC = None
+_QUARTIC: list[list[tuple[int, int, Fraction]]] | None = None
 
 
-def _rational_quartic(h, u):
+def _rational_quartic(h: Fraction, u: Fraction) -> tuple[Fraction, ...]:
     """The sinusoidal pair's Study point in u = tan(θ/4), from the derived polynomials."""
     global _QUARTIC
     if _QUARTIC is None:
@@ -173,9 +182,9 @@ def _rational_quartic(h, u):
     return tuple(sum((c * u**i * h**k for i, k, c in terms), Fraction(0) * u) for terms in _QUARTIC)
 
 
-def _sample_exact(js, count: int, rng: random.Random) -> list[list[int]]:
+def _sample_exact(js: Sequence[JointDesign[Fraction]], count: int, rng: random.Random) -> list[list[int]]:
     """Primitive integer Study points of the chain at random rational parameters."""
-    pts = []
+    pts: list[list[int]] = []
     while len(pts) < count:
         us = [Fraction(rng.randint(-40, 40), rng.randint(1, 40)) for _ in js]
         P = _pair_point_exact(js[0], us[0])
@@ -190,7 +199,7 @@ def _sample_exact(js, count: int, rng: random.Random) -> list[list[int]]:
     return pts
 
 
-def monomials(k: int) -> list[tuple[int, ...]]:
+def monomials(k: int) -> list[Exponents]:
     """Exponent vectors of the degree-k monomials in x0..y3, in a fixed order."""
     out = []
     for combo in itertools.combinations_with_replacement(range(8), k):
@@ -201,14 +210,14 @@ def monomials(k: int) -> list[tuple[int, ...]]:
     return out
 
 
-def _monomial_rows(points, mons):
+def _monomial_rows(points: Sequence[Sequence[int]], mons: Sequence[Exponents]) -> list[list[int]]:
     rows = []
     for p in points:
         rows.append([math.prod(p[i] ** e for i, e in enumerate(m) if e) for m in mons])
     return rows
 
 
-def _forms_exact(points, k):
+def _forms_exact(points: Sequence[Sequence[int]], k: int) -> tuple[list[Exponents], list[list[int]]]:
     """RREF basis (integer rows, primitive) of the degree-k forms vanishing at the points."""
     import flint
 
@@ -229,7 +238,7 @@ def _forms_exact(points, k):
     return mons, rows
 
 
-def _rank_mod_p(rows) -> int:
+def _rank_mod_p(rows: Sequence[Sequence[float]]) -> int:
     import flint
 
     if len(rows) == 0:
@@ -237,7 +246,7 @@ def _rank_mod_p(rows) -> int:
     return flint.nmod_mat([[int(v) % PRIME for v in r] for r in rows], PRIME).rank()
 
 
-def _monomial_rows_mod_p(points, mons) -> np.ndarray:
+def _monomial_rows_mod_p(points: Sequence[Sequence[int]], mons: Sequence[Exponents]) -> NDArray[np.int64]:
     """The monomial matrix modulo PRIME, vectorised over the points."""
     P = np.array([[v % PRIME for v in p] for p in points], dtype=np.int64)
     k = sum(mons[0])
@@ -254,13 +263,15 @@ def _monomial_rows_mod_p(points, mons) -> np.ndarray:
     return out
 
 
-def _shift(rows_prev, mons_prev, mons):
+def _shift(
+    rows_prev: Sequence[Sequence[float]], mons_prev: Sequence[Exponents], mons: Sequence[Exponents]
+) -> list[list[float]]:
     """x_j · F for every F of degree k−1 and every variable, in the degree-k monomial basis."""
     index = {m: i for i, m in enumerate(mons)}
-    out = []
+    out: list[list[float]] = []
     for r in rows_prev:
         for j in range(8):
-            v = [0] * len(mons)
+            v: list[float] = [0] * len(mons)
             for coeff, m in zip(r, mons_prev):
                 if coeff:
                     e = list(m)
@@ -270,11 +281,11 @@ def _shift(rows_prev, mons_prev, mons):
     return out
 
 
-def _poly(row, mons):
+def _poly(row: Sequence[float], mons: Sequence[Exponents]) -> Any:
     return sp.Poly.from_dict({m: int(c) for m, c in zip(mons, row) if c}, *VARS)
 
 
-def constraint_variety(chain, max_degree: int = 4, hilbert_degree: int = 6, seed: int = 0) -> Variety:
+def constraint_variety(chain: ChainLike, max_degree: int = 4, hilbert_degree: int = 6, seed: int = 0) -> Variety:
     """The equations of a 2-joint chain's poses, generating every vanishing form of degree ≤ max_degree."""
     if chain.n != 2:
         raise ValueError(f"chain: constraint varieties are computed for 2-pair chains, this one has {chain.n}")
@@ -282,8 +293,11 @@ def constraint_variety(chain, max_degree: int = 4, hilbert_degree: int = 6, seed
     if not exact:
         return _constraint_variety_float(chain, max_degree, seed)
     rng = random.Random(seed)
-    equations, dims, hilbert = [], {}, {}
-    prev_rows, prev_mons = [], None
+    equations: list[Any] = []
+    dims: dict[int, int] = {}
+    hilbert: dict[int, int] = {}
+    prev_rows: list[list[int]] = []
+    prev_mons: list[Exponents] = []
     for k in range(1, max_degree + 1):
         mons = monomials(k)
         pts = _sample_exact(js, len(mons) + 24, rng)
@@ -293,7 +307,7 @@ def constraint_variety(chain, max_degree: int = 4, hilbert_degree: int = 6, seed
         # the generators of degree k that x_j · (lower degrees) do not already give
         known = _shift(prev_rows, prev_mons, mons) if prev_rows else []
         r = _rank_mod_p(known)
-        kept = []
+        kept: list[list[int]] = []
         for row in rows:
             if r + len(kept) == len(rows):
                 break  # the lower degrees already give every form of degree k
@@ -326,11 +340,11 @@ def constraint_variety(chain, max_degree: int = 4, hilbert_degree: int = 6, seed
     )
 
 
-def _constraint_variety_float(chain, max_degree, seed):
+def _constraint_variety_float(chain: ChainLike, max_degree: int, seed: int) -> Variety:
     """Floating-point variant: SVD nullspaces on sampled poses, with residuals on fresh poses."""
     rng = np.random.default_rng(seed)
 
-    def poses(count):
+    def poses(count: int) -> NDArray[np.float64]:
         q = np.empty((count, 2))
         for i, p in enumerate(chain.pairs):
             lim = p.theta_limit or np.pi

@@ -11,13 +11,19 @@ interpolation. The drawing is a small canvas renderer (no library, nothing fetch
 from __future__ import annotations
 
 import json
+import os
 from html import escape
 from importlib import resources
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from . import collisions
 from .files import write_text
+
+if TYPE_CHECKING:
+    from ._typing import ChainLike, PairLike
 
 CLEARANCE_STEP = np.radians(0.25)  # the clearance table's spacing in θ
 
@@ -30,7 +36,7 @@ def _page_template() -> str:
     return resources.files("apair").joinpath("data/view.html").read_text(encoding="utf-8")
 
 
-def _clearance_table(pair, lo: float, hi: float) -> dict:
+def _clearance_table(pair: PairLike, lo: float, hi: float) -> dict[str, Any]:
     th = np.arange(lo, hi + CLEARANCE_STEP / 2, CLEARANCE_STEP)
     th = th[th <= hi]
     legs, plates = collisions.clearances(pair, th)
@@ -42,17 +48,17 @@ def _clearance_table(pair, lo: float, hi: float) -> dict:
     }
 
 
-def chain_data(chain, workspace: int = 0, seed: int = 0) -> dict:
+def chain_data(chain: ChainLike, workspace: int = 0, seed: int = 0) -> dict[str, Any]:
     """What the page needs of the chain: its joints (law kernel and parameters, DH row, range),
     the A-pairs' radii and clearance tables, and optionally `workspace` sampled end points."""
     lim = np.array(chain.limits, float)
-    joints = []
+    joints: list[dict[str, Any]] = []
     for i, p in enumerate(chain.pairs):
         kernel, params = p.law_kernel
         lo, hi = lim[i]
         period = 2 * np.pi if p.kind == "revolute" else 4 * np.pi
         lo, hi = (max(lo, -period / 2), min(hi, period / 2))
-        j = {
+        j: dict[str, Any] = {
             "kind": p.kind,
             "law": kernel,
             "params": [float(x) for x in params],
@@ -65,7 +71,7 @@ def chain_data(chain, workspace: int = 0, seed: int = 0) -> dict:
             j["leg_radius"] = float(p.leg_radius)
             j["clearance"] = _clearance_table(p, lo, hi)
         joints.append(j)
-    data = {"name": getattr(chain, "name", None) or "apair chain", "n": chain.n, "joints": joints}
+    data: dict[str, Any] = {"name": getattr(chain, "name", None) or "apair chain", "n": chain.n, "joints": joints}
     if workspace:
         rng = np.random.default_rng(seed)
         q = rng.uniform([j["lower"] for j in joints], [j["upper"] for j in joints], (workspace, chain.n))
@@ -73,7 +79,7 @@ def chain_data(chain, workspace: int = 0, seed: int = 0) -> dict:
     return data
 
 
-def to_html(chain, workspace: int = 0) -> str:
+def to_html(chain: ChainLike, workspace: int = 0) -> str:
     """The viewer page of the chain (see the module's docstring)."""
     if not isinstance(workspace, (int, np.integer)) or isinstance(workspace, bool) or workspace < 0:
         raise ValueError(f"workspace: expected a number of samples >= 0, got {workspace!r}")
@@ -87,7 +93,7 @@ def to_html(chain, workspace: int = 0) -> str:
     )
 
 
-def write(chain, path, overwrite: bool = False, workspace: int = 0):
+def write(chain: ChainLike, path: str | os.PathLike[str], overwrite: bool = False, workspace: int = 0) -> Path:
     """Writes the page to path (.html added if it has no suffix); an existing file only with
     overwrite=True. Returns the path."""
     return write_text(path, to_html(chain, workspace), overwrite, ".html")

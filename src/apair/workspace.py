@@ -25,12 +25,20 @@ per voxel size and offset (45 of them).
 from __future__ import annotations
 
 import math
+import os
 import sys
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, TextIO, TypeAlias, cast
 
 import numpy as np
+from numpy.typing import NDArray
 
 from . import figures
+
+if TYPE_CHECKING:
+    from ._typing import ChainLike
 
 LEVELS = (1.0, 1.25, 1.5, 1.75, 2.0)  # voxel sizes in units of h₀
 OFFSETS = 3  # random grid offsets per voxel size
@@ -41,6 +49,19 @@ MAX_GRID_BYTES = 2 * 2**30  # a voxel grid larger than this is refused, not atte
 MAX_SAMPLE_BYTES = 8 * 2**30  # the kept samples (points, joint values, poses)
 LOCAL_ENGINES = ("threads", "processes", "synchronous")
 CONNECT_TIMEOUT = "10s"  # to reach a scheduler address
+
+Progress: TypeAlias = Callable[[int, int], object]  # progress(done, total)
+# a batch of samples (_batch's arguments): chain, limits lo and hi, seed, count, centres, sigma, poses
+_Task: TypeAlias = tuple[
+    "ChainLike",
+    NDArray[np.float64],
+    NDArray[np.float64],
+    tuple[int, int, int],
+    int,
+    NDArray[np.float64] | None,
+    NDArray[np.float64] | None,
+    bool,
+]
 
 
 @dataclass
@@ -55,14 +76,14 @@ class Workspace:
     history: (samples, corrected occupancy volume at h₀) after each round, the convergence record.
     """
 
-    points: np.ndarray
-    q: np.ndarray
-    boundary: np.ndarray
+    points: NDArray[np.float64]
+    q: NDArray[np.float64]
+    boundary: NDArray[np.float64]
     voxel: float
     volume: float | None
     volume_error: float | None
-    poses: np.ndarray | None = None
-    history: list = field(default_factory=list)
+    poses: NDArray[np.float64] | None = None
+    history: list[tuple[int, float]] = field(default_factory=list)
     chain_name: str = ""
     dimension: int = 3
     measure: float | None = None
@@ -79,18 +100,28 @@ class Workspace:
             f"(from voxel crossings, a few per cent)"
         )
 
-    def plot(self, path, overwrite: bool = False):
+    def plot(self, path: str | os.PathLike[str], overwrite: bool = False) -> Path:
         """A 3D view of the points and three cross-sections through the centre (matplotlib)."""
         return figures.workspace(self, path, overwrite=overwrite)
 
 
-def _batch(chain, q_lo, q_hi, seed, count, centres, sigma, poses):
+def _batch(
+    chain: ChainLike,
+    q_lo: NDArray[np.float64],
+    q_hi: NDArray[np.float64],
+    seed: tuple[int, int, int],
+    count: int,
+    centres: NDArray[np.float64] | None,
+    sigma: NDArray[np.float64] | None,
+    poses: bool,
+) -> dict[str, NDArray[np.float64]]:
     """One batch of samples: uniform in the limits, or Gaussian about centres (reflected)."""
     rng = np.random.default_rng(seed)
     if centres is None:
         q = rng.uniform(q_lo, q_hi, (count, len(q_lo)))
     else:
-        q = centres[rng.integers(0, len(centres), count)] + rng.normal(0.0, 1.0, (count, len(q_lo))) * sigma
+        step = cast(NDArray[np.float64], sigma)  # given with the centres
+        q = centres[rng.integers(0, len(centres), count)] + rng.normal(0.0, 1.0, (count, len(q_lo))) * step
         span = q_hi - q_lo
         q = q_lo + span - np.abs(np.mod(q - q_lo, 2 * span) - span)  # reflected into [lo, hi]
     T = chain.fk(q)
@@ -100,10 +131,10 @@ def _batch(chain, q_lo, q_hi, seed, count, centres, sigma, poses):
     return out
 
 
-def _run(tasks, engine, progress):
+def _run(tasks: Sequence[_Task], engine: object, progress: Progress | None) -> list[dict[str, NDArray[np.float64]]]:
     """Evaluate the batch tasks locally or on Dask, in order."""
     if engine is None:
-        out = []
+        out: list[dict[str, NDArray[np.float64]]] = []
         for k, t in enumerate(tasks):
             out.append(_batch(*t))
             if progress:
@@ -136,7 +167,7 @@ def _run(tasks, engine, progress):
     return list(res)
 
 
-def _check_engine(engine) -> None:
+def _check_engine(engine: object) -> None:
     """engine: None, a local Dask scheduler name, a scheduler address or a Client."""
     if engine is None:
         return
@@ -156,7 +187,7 @@ def _check_engine(engine) -> None:
         )
 
 
-def _voxels(points, origin, h):
+def _voxels(points: NDArray[np.float64], origin: NDArray[np.float64], h: float) -> NDArray[np.int64]:
     """The distinct voxel indices (k, 3) hit by the points (grid anchored at origin)."""
     idx = np.floor((points - origin) / h).astype(np.int64)
     base = idx.min(axis=0)
@@ -165,21 +196,21 @@ def _voxels(points, origin, h):
     return np.stack(np.unravel_index(flat, dims), axis=1) + base
 
 
-def _grid(vox):
+def _grid(vox: NDArray[np.int64]) -> NDArray[np.bool_]:
     lo = vox.min(axis=0) - 1
     grid = np.zeros(vox.max(axis=0) - lo + 2, dtype=bool)
     grid[tuple((vox - lo).T)] = True
     return grid
 
 
-def _corrected_volume(points, origin, h):
+def _corrected_volume(points: NDArray[np.float64], origin: NDArray[np.float64], h: float) -> float:
     """h³ (occupied voxels − ½ exposed faces): the occupancy volume without its half-voxel layer."""
     grid = _grid(_voxels(points, origin, h))
     faces = sum(np.count_nonzero(np.diff(grid, axis=a)) for a in range(3))
     return (np.count_nonzero(grid) - 0.5 * faces) * h**3
 
 
-def _boundary(points, origin, h):
+def _boundary(points: NDArray[np.float64], origin: NDArray[np.float64], h: float) -> NDArray[np.int64]:
     """Occupied voxels with an empty face neighbour: their integer indices."""
     vox = _voxels(points, origin, h)
     grid = _grid(vox)
@@ -193,15 +224,17 @@ def _boundary(points, origin, h):
     return vox[~full]
 
 
-def _estimate(points, origin, h0, rng):
+def _estimate(
+    points: NDArray[np.float64], origin: NDArray[np.float64], h0: float, rng: np.random.Generator
+) -> tuple[float, float]:
     """Intercept and standard error of V(h) = V + c₁h over LEVELS × OFFSETS."""
-    hs, vs = [], []
+    sizes, volumes = [], []
     for level in LEVELS:
         h = h0 * level
         for _ in range(OFFSETS):
-            hs.append(h)
-            vs.append(_corrected_volume(points, origin - rng.uniform(0, h, 3), h))
-    hs, vs = np.array(hs), np.array(vs)
+            sizes.append(h)
+            volumes.append(_corrected_volume(points, origin - rng.uniform(0, h, 3), h))
+    hs, vs = np.array(sizes), np.array(volumes)
     A = np.stack([np.ones_like(hs), hs], axis=1)
     coef, *_ = np.linalg.lstsq(A, vs, rcond=None)
     resid = vs - A @ coef
@@ -213,14 +246,14 @@ def _estimate(points, origin, h0, rng):
 
 
 def workspace(
-    chain,
+    chain: ChainLike,
     samples: int = 200_000,
     resolution: int = 40,
     rounds: int = 4,
     poses: bool = False,
-    engine=None,
+    engine: object = None,
     seed: int = 0,
-    progress=None,
+    progress: Progress | None = None,
 ) -> Workspace:
     """Approximate the reachable workspace of the end-effector origin (see the module docstring).
 
@@ -252,23 +285,17 @@ def workspace(
     lo, hi = lim[:, 0], lim[:, 1]
     per_round = samples // rounds
     sigma = 0.05 * (hi - lo)
-    parts: list[dict] = []
-    history = []
-    origin = h0 = pts = qs = None
+    parts: list[dict[str, NDArray[np.float64]]] = []
+    history: list[tuple[int, float]] = []
+    # the round's centres of its Gaussian samples and their spread (none in the first round)
+    centres: NDArray[np.float64] | None = None
+    step: NDArray[np.float64] | None = None
     done, total = 0, rounds * math.ceil(per_round / BATCH)
     for r in range(rounds):
         counts = [min(BATCH, per_round - k) for k in range(0, per_round, BATCH)]
-        if r == 0:
-            tasks = [(chain, lo, hi, (seed, r, k), c, None, None, poses) for k, c in enumerate(counts)]
-        else:
-            edge = _boundary(pts, origin, h0)
-            key = np.floor((pts - origin) / h0).astype(np.int64)
-            on_edge = _member(key, edge)
-            centres = qs[on_edge] if on_edge.any() else qs
-            step = sigma / (1 + r)
-            tasks = [
-                (chain, lo, hi, (seed, r, k), c, centres if k % 2 else None, step, poses) for k, c in enumerate(counts)
-            ]
+        tasks: list[_Task] = [
+            (chain, lo, hi, (seed, r, k), c, centres if k % 2 else None, step, poses) for k, c in enumerate(counts)
+        ]
         tick = (lambda k, _n, done=done: progress(done + k, total)) if progress else None
         parts += _run(tasks, engine, tick)
         done += len(counts)
@@ -282,6 +309,12 @@ def workspace(
             h0 = side / resolution
             origin = box_lo - 0.5 * h0
         history.append((len(pts), _corrected_volume(pts, origin, h0)))
+        if r + 1 < rounds:  # the next round: half of its samples near those in boundary voxels
+            edge = _boundary(pts, origin, h0)
+            key = np.floor((pts - origin) / h0).astype(np.int64)
+            on_edge = _member(key, edge)
+            centres = qs[on_edge] if on_edge.any() else qs
+            step = sigma / (1 + (r + 1))
     dimension = _dimension(chain, qs, side)
     edge = _boundary(pts, origin, h0)
     if dimension < 3:
@@ -321,21 +354,28 @@ def workspace(
     )
 
 
-def _dimension(chain, qs, side: float, probes: int = 256) -> int:
+def _dimension(chain: ChainLike, qs: NDArray[np.float64], side: float, probes: int = 256) -> int:
     """The dimension of the reachable point set: the largest rank of the position rows of the
     Jacobian over a spread of samples (relative tolerance 1e-7 of the workspace's size)."""
     J = chain.jacobian(qs[:: max(1, len(qs) // probes)])[:, :3, :]
     return int(np.linalg.matrix_rank(J, tol=1e-7 * max(side, 1e-300)).max())
 
 
-def _measure(chain, pts, qs, origin, h, dimension: int) -> float:
+def _measure(
+    chain: ChainLike,
+    pts: NDArray[np.float64],
+    qs: NDArray[np.float64],
+    origin: NDArray[np.float64],
+    h: float,
+    dimension: int,
+) -> float:
     """Length (dimension 1) or area (2) of the reachable set from the voxels its samples occupy:
     a curve with unit tangent t crosses |t|₁/h voxels per unit length, a surface with unit normal n
     |n|₁/h² per unit area, so each occupied voxel contributes h/|t|₁ (h²/|n|₁) with the tangent
     (normal) of one sample in it, from the Jacobian there; measured at the voxel sizes LEVELS and
     extrapolated linearly to size 0."""
 
-    def at(size):
+    def at(size: float) -> float:
         idx = np.floor((pts - origin) / size).astype(np.int64)
         _, first = np.unique(idx, axis=0, return_index=True)
         U = np.linalg.svd(chain.jacobian(qs[first])[:, :3, :])[0]  # (k, 3, 3): left singular vectors
@@ -348,7 +388,7 @@ def _measure(chain, pts, qs, origin, h, dimension: int) -> float:
     return float(np.polyfit(sizes, values, 1)[1])
 
 
-def _coverage_remainder(history) -> float | None:
+def _coverage_remainder(history: Sequence[tuple[int, float]]) -> float | None:
     """The volume still to come as the sample count grows without bound, from the occupancy of the
     last three rounds: V(N) = V∞ − A·N^(−γ) fitted exactly; None when the rounds do not grow
     like that (fewer than three rounds, no growth, or growth that does not slow down)."""
@@ -359,7 +399,7 @@ def _coverage_remainder(history) -> float | None:
     if not (d1 > 0 and d2 > 0 and d1 > d2):
         return None
 
-    def ratio(g):
+    def ratio(g: float) -> float:
         return (n1**-g - n2**-g) / (n2**-g - n3**-g)
 
     lo, hi = 1e-3, 5.0
@@ -373,7 +413,7 @@ def _coverage_remainder(history) -> float | None:
     return float(d2 * n3**-g / (n2**-g - n3**-g))
 
 
-def _member(keys, table):
+def _member(keys: NDArray[np.int64], table: NDArray[np.int64]) -> NDArray[np.bool_]:
     """Rows of keys (m, 3) that occur in table (k, 3)."""
     both = np.concatenate([table, keys])
     _, inv = np.unique(both, axis=0, return_inverse=True)
@@ -383,10 +423,10 @@ def _member(keys, table):
     return in_table[inv[len(table) :]]
 
 
-def text_progress(stream=None, width: int = 40):
+def text_progress(stream: TextIO | None = None, width: int = 40) -> Callable[[int, int], None]:
     """A progress bar for the command line (on stderr by default): callable(done, total)."""
 
-    def show(done, total):
+    def show(done: int, total: int) -> None:
         out = stream or sys.stderr
         filled = int(width * done / max(total, 1))
         out.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{total} batches")

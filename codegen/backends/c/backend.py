@@ -3,9 +3,10 @@
 Its files: apair.h (the one public header, the registry's types and every kernel's declarations),
 apair_internal.h (the split form of the kernels other kernels call, the extended-precision
 kernels), apair_registry.c (every kernel by name), one source per kernel (a program that links the
-library takes only the kernels it calls), the hand-written solvers copied from src/csrc, and
-CMakeLists.txt and apair.pc.in to build and install it. The header's content hash covers every C
-source, so it identifies the library; the manifest records it with the sources' digest.
+library takes only the kernels it calls), the hand-written solvers copied from src/csrc (every .c
+and .h there: the sources, and their private header), and CMakeLists.txt and apair.pc.in to build
+and install it. The header's content hash covers every C source and header, so it identifies the
+library; the manifest records it with the sources' digest.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from ...templating import VERSION, Templates, TemplateSource
 TEMPLATES = Templates(Path(__file__).parent / "templates")
 PREFIX = "apair_"
 ROOT = Path(__file__).resolve().parents[3]
-HAND_WRITTEN = ("src/csrc/apair_ik.c",)  # hand-written C of the library, relative to the source tree
+HAND_WRITTEN = "src/csrc"  # the hand-written C of the library (every .c and .h), relative to the source tree
 
 
 @dataclass
@@ -46,18 +47,21 @@ def ops_per_item(k: Lowered, by_name: dict[str, Lowered]) -> int:
 
 
 def copies(template: TemplateSource = TEMPLATES) -> dict[str, str]:
-    """{file name: text} of the hand-written C files, each under a banner that names its origin."""
+    """{file name: text} of the hand-written C files (the sources and private headers in
+    src/csrc, in name order), each under a banner that names its origin."""
     banner, banner_src = template("copied.c.j2")
+    folder = ROOT / HAND_WRITTEN
+    paths = sorted(p for p in folder.glob("*") if p.suffix in (".c", ".h")) if folder.is_dir() else []
+    if not any(p.suffix == ".c" for p in paths):
+        raise FileNotFoundError(
+            f"{HAND_WRITTEN}: the C library's hand-written sources are read from the source "
+            f"tree ({ROOT}), which this installation does not have"
+        )
     out = {}
-    for origin in HAND_WRITTEN:
-        path = ROOT / origin
-        if not path.is_file():
-            raise FileNotFoundError(
-                f"{origin}: the C library's hand-written sources are read from the source "
-                f"tree ({ROOT}), which this installation does not have"
-            )
+    for path in paths:
+        origin = f"{HAND_WRITTEN}/{path.name}"
         text = path.read_text()
-        out[Path(origin).name] = banner.render(origin=origin, hash=content_hash([banner_src, text])) + text
+        out[path.name] = banner.render(origin=origin, hash=content_hash([banner_src, text])) + text
     return out
 
 
@@ -108,13 +112,17 @@ def render(kernels: list[Lowered], template: TemplateSource = TEMPLATES) -> Libr
     hand_written = copies(template)
     files.update({f"c/{name}": text for name, text in hand_written.items()})
 
-    c_sources = sorted(["apair_registry.c", *hand_written] + [f"{k.name}.c" for k in kernels])
+    hand_headers = sorted(name for name in hand_written if name.endswith(".h"))  # private: not installed
+    c_sources = sorted(
+        ["apair_registry.c"] + [n for n in hand_written if n.endswith(".c")] + [f"{k.name}.c" for k in kernels]
+    )
     header_t, header_src = template("apair.h.j2")
     header_hash = content_hash(
         [header_src, VERSION]
         + [fingerprints[k.name] for k in kernels]
         + [files[f"c/{c}"] for c in c_sources]
         + [files["c/apair_internal.h"]]
+        + [files[f"c/{h}"] for h in hand_headers]
     )
     files["c/apair.h"] = header_t.render(
         kernels=kernels, hash=header_hash, sources=sources, prefix=PREFIX, version=VERSION, inv_sizes=inv_sizes

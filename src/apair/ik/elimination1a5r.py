@@ -160,7 +160,8 @@ def eliminate(dh: np.ndarray, h: float, k: int, T: np.ndarray, plain: bool = Fal
 
 def _split(k: int) -> tuple[tuple[int, int], int, tuple[int, int]]:
     """(joints k+1, k+2), the eliminated joint k+3, (the right pair r1 < r2): 1-based, as the kernels'."""
-    return (k + 1, k + 2), k + 3, tuple(sorted(set(range(1, 7)) - {k, k + 1, k + 2, k + 3}))
+    r1, r2 = sorted(set(range(1, 7)) - {k, k + 1, k + 2, k + 3})
+    return (k + 1, k + 2), k + 3, (r1, r2)
 
 
 def angles(
@@ -181,7 +182,7 @@ def angles(
     basis = np.stack([C**i * S**j for i, j in [(i, 0) for i in range(5)] + [(i, 1) for i in range(4)]], 1)
     cs = cos_sin(psi[:, [m1 - 1, m2 - 1]])
     X = np.einsum("ki,kj->kij", cs[:, 0], cs[:, 1]).reshape(m, 9)
-    XR = np.ones((m, 9), complex)  # (1, c, s)_{r1} ⊗ (1, c, s)_{r2}, the rest by least squares
+    XR: np.ndarray = np.ones((m, 9), complex)  # (1, c, s)_{r1} ⊗ (1, c, s)_{r2}, the rest by least squares
     XR[:, 1:] = (basis[:, :, None] * X[:, None, :]).reshape(m, 81) @ P.T @ L
     XR = XR.reshape(m, 3, 3)
     # XR = a bᵀ, a = (1, c, s)_{r1}, b = (1, c, s)_{r2}: a from its largest column, b from its

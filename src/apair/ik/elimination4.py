@@ -259,7 +259,9 @@ class Elimination:
                 continue
         return out
 
-    def _quadric_images(self, C: np.ndarray, factors=None) -> list[np.ndarray]:
+    def _quadric_images(
+        self, C: np.ndarray, factors: list[tuple[int, int]] | None = None
+    ) -> np.ndarray | list[np.ndarray]:
         """Coefficients (u_3^i u_4^j) of Q(W(u_3, u_4)) for the rotation quadric Qx (first: f), three
         random combinations Q of the left half's quadrics and the one without a yy block (last,
         where there is one), from one FFT of W, each divided by
@@ -273,7 +275,7 @@ class Elimination:
             return images
         return [isotropic_quotient(g, k) for g, k in zip(images, factors)]
 
-    def _resultant_roots(self, C: np.ndarray):
+    def _resultant_roots(self, C: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray] | None]:
         """Every u_3 at which two conditions on W(u_3, u_4) have a common root u_4: the rotation
         condition f (bidegree (4, 4)) with a combination g of the quadrics (the one without a yy
         block first: bidegree (6, 6), 48 roots, 32 once deflated, `deflate`), else (where f
@@ -333,7 +335,9 @@ class Elimination:
     def _factor_array(self, k: int) -> np.ndarray:
         return np.array(self.factors[k], np.int32)
 
-    def _screen(self, u3s: np.ndarray, pair, C: np.ndarray):
+    def _screen(
+        self, u3s: np.ndarray, pair: tuple[np.ndarray, np.ndarray] | None, C: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The real u_3 sorted by two steps of inverse iteration: the Sylvester matrix of the
         eliminated pair `pair` is singular at each u_3, and where its null vector comes out as
         (1, u_4, u_4², …) (one common root u_4), the left half's quadrics on W(u_3, u_4) accept the
@@ -392,7 +396,7 @@ class Elimination:
         rel = np.abs(np.einsum("ra,kab,rb->rk", W, self.Q, W)).max(axis=1) / np.maximum(np.sum(W * W, axis=1), 1e-300)
         return W, rel
 
-    def _right_pairs(self, u3s: np.ndarray, C: np.ndarray, real: bool):
+    def _right_pairs(self, u3s: np.ndarray, C: np.ndarray, real: bool) -> tuple[np.ndarray, np.ndarray]:
         """For each u_3, the u_4 where every quadric of the left half vanishes on W(u_3, u_4) (their
         common roots: complete even where f or g alone vanishes for all u_4 at that u_3); the
         pairs (r, 2) and their images W (r, 8). A u_3 at which all of them vanish for every u_4
@@ -403,15 +407,15 @@ class Elimination:
         outer = (Cu[:, None] @ self.Q) @ np.swapaxes(Cu, 1, 2)[:, None]  # (R, k, D4+1, D4+1)
         D = Cu.shape[1]
         polys = outer.reshape(outer.shape[:2] + (D * D,)) @ product_map(D, D)
-        owner, u4 = [np.zeros(0, int)], [np.zeros(0, complex if not real else float)]
+        owners, roots = [np.zeros(0, int)], [np.zeros(0, complex if not real else float)]
         for r, u4s in enumerate(common_roots_many(polys, self.rng)):
             if u4s is None:  # every quadric vanishes for all u4 at this u3
                 continue
             if real:
                 u4s = u4s[np.abs(u4s.imag) <= CAND_TOL * (1 + np.abs(u4s))].real
-            owner.append(np.full(len(u4s), r))
-            u4.append(u4s)
-        owner, u4 = np.concatenate(owner), np.concatenate(u4)
+            owners.append(np.full(len(u4s), r))
+            roots.append(u4s)
+        owner, u4 = np.concatenate(owners), np.concatenate(roots)
         if len(u4) == 0:
             return np.zeros((0, 2)), np.zeros((0, 8))
         images = np.einsum("kj,kja->ka", u4[:, None] ** np.arange(D), Cu[owner])
@@ -422,6 +426,8 @@ class Elimination:
         on the image W = T·(A_3 A_4)~, then the left half for each W."""
         LT = left_matrix(T)
         C = self.image @ LT.T
+        rights: np.ndarray | list[np.ndarray]
+        images: np.ndarray | list[np.ndarray]
         if self.chain.n == 3:
             G = np.einsum("ma,qab,kb->qmk", C, self.Q, C)
             G = G.reshape(len(G), -1) @ product_map(*G.shape[1:])
@@ -447,7 +453,7 @@ class Elimination:
 
 
 # ----------------------------------------------------------------------------- helpers
-def _close_pairs(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _close_pairs(x: np.ndarray) -> tuple[np.ndarray, ...]:
     """Indices i < j of the rows of x (r, m) that agree to CAND_TOL in every entry."""
     close = np.all(np.abs(x[:, None] - x[None]) <= CAND_TOL * (1 + np.abs(x[:, None])), axis=-1)
     return np.nonzero(np.triu(close, 1))

@@ -6,8 +6,10 @@ of `distance`), and `ik_local`, the same search in C from the user's seeds.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .. import _validate as V
 from ..kernels import native_module
@@ -15,8 +17,11 @@ from .homotopy.problem import scale_of
 from .pencil import SEED
 from .poses import check_matrix, error_weights, jacobian_rank, joint_periods, matrix_of, pose_error, study_point
 
+if TYPE_CHECKING:
+    from .._typing import ChainLike
 
-def on_continuum(chain, q: np.ndarray, T: np.ndarray, tol: float) -> bool:
+
+def on_continuum(chain: ChainLike, q: NDArray[np.float64], T: NDArray[np.float64], tol: float) -> bool:
     """Whether the solution q lies on a curve of solutions: where the Jacobian is rank-deficient,
     a step along its null space, corrected back onto the pose, lands on another solution."""
     if jacobian_rank(chain, q[None])[0] == chain.n:
@@ -28,14 +33,14 @@ def on_continuum(chain, q: np.ndarray, T: np.ndarray, tol: float) -> bool:
 
 
 def local_search(
-    chain,
-    T: np.ndarray,
+    chain: ChainLike,
+    T: NDArray[np.float64],
     seeds: int = 64,
     iterations: int = 60,
     seed: int = SEED,
-    bounds: np.ndarray | None = None,
-    start: np.ndarray | None = None,
-) -> np.ndarray:
+    bounds: NDArray[np.float64] | None = None,
+    start: NDArray[np.float64] | None = None,
+) -> NDArray[np.float64]:
     """Levenberg-Marquardt on the pose error from `seeds` joint vectors drawn uniformly (in
     `bounds` (n, 2), default each joint's period), all at once over the batched fk and Jacobian
     kernels (or from the rows of `start`); returns the end points, kept inside the bounds. Not
@@ -71,7 +76,9 @@ def local_search(
     return q
 
 
-def distance(chain, T, starts: int = 64, seed: int = SEED) -> tuple[float, float, np.ndarray]:
+def distance(
+    chain: ChainLike, T: ArrayLike, starts: int = 64, seed: int = SEED
+) -> tuple[float, float, NDArray[np.float64]]:
     """How far a pose is from the chain's reach inside its joint limits (`chain.limits`):
     (position error [m], rotation error [rad], q) at the best of `starts` batched
     Levenberg-Marquardt fits of fk(q) to T (pose error weighted by the chain's length scale), a
@@ -93,12 +100,12 @@ class LocalSolution:
     """ik_local's result, one row per (pose, seed): q (..., n), the largest entry of |fk(q) − T|
     and whether it is within tol."""
 
-    q: np.ndarray
-    residual: np.ndarray
-    converged: np.ndarray
+    q: NDArray[np.float64]
+    residual: NDArray[np.float64]
+    converged: NDArray[np.bool_]
 
 
-def ik_local(chain, T, q0, tol: float = 1e-10, max_iter: int = 100) -> LocalSolution:
+def ik_local(chain: ChainLike, T: ArrayLike, q0: ArrayLike, tol: float = 1e-10, max_iter: int = 100) -> LocalSolution:
     """Levenberg-Marquardt from the seeds q0 (n,) or (..., n) to the poses T (4, 4) or (..., 4, 4)
     (broadcast together), each step projected onto chain.limits, in C (apair_ik_local on the fk and
     Jacobian kernels)."""

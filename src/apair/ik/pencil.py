@@ -169,7 +169,7 @@ def _isotropic_product(d: int) -> np.ndarray:
     return np.eye(d + 3, d + 1) + np.eye(d + 3, d + 1, -2)
 
 
-def deflate(f: np.ndarray, g: np.ndarray, tol: float = None) -> np.ndarray | None:
+def deflate(f: np.ndarray, g: np.ndarray, tol: float | None = None) -> np.ndarray | None:
     """g'' = (g − a·f) / (1 + u²) for bivariate f, g (coefficients [i, j] of u^i v^j, g's degree in v
     at least f's), where g(±i, v) = f(±i, v)·h(v) (to relative residual tol): a(u, v) = Re h(v) +
     u Im h(v), so g − a·f vanishes at u = ±i. f and g'' have the common roots of f and g except

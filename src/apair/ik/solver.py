@@ -10,8 +10,10 @@ refined by apair.ik.poses.refine.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import elimination1a5r, elimination6r, homotopy
 from .elimination4 import CAND_TOL, Elimination
@@ -19,6 +21,10 @@ from .homotopy.problem import scale_of
 from .local import local_search, on_continuum
 from .pencil import SEED, Degenerate
 from .poses import jacobian_rank, matrix_of, near_reach, pose_matrix, refine, study_point, with_twins
+
+if TYPE_CHECKING:
+    from .._typing import ChainLike
+    from .homotopy import Endpoints, Problem, StartSystem
 
 
 @dataclass
@@ -31,12 +37,12 @@ class Solution:
     solutions come from the local fallback search, so that the set may be incomplete; method: how
     the set was found."""
 
-    q: np.ndarray
-    error: np.ndarray
+    q: NDArray[np.float64]
+    error: NDArray[np.float64]
     candidates: int
     complex_count: int | None = None
     certified: bool = True
-    inside: np.ndarray | None = None  # (k,) within the chain's joint limits (set by AChain.ik)
+    inside: NDArray[np.bool_] | None = None  # (k,) within the chain's joint limits (set by AChain.ik)
     method: str = "elimination"  # or "homotopy" (n = 5, 6), or "local search" (the fallback)
 
 
@@ -47,7 +53,7 @@ class Solver:
     within reach) it runs on the reversed chain, and where that degenerates too a batched local
     search from many seeds gives the solutions, marked as not certified complete."""
 
-    def __init__(self, chain, seed: int = SEED):
+    def __init__(self, chain: ChainLike, seed: int = SEED) -> None:
         n = chain.n
         if n not in (1, 2, 3, 4, 5, 6):
             raise ValueError(f"chain: inverse kinematics covers chains of 1 to 6 pairs, this one has {n}")
@@ -60,16 +66,16 @@ class Solver:
         self.chain = chain
         self.scale = scale_of(chain)
         self.seed = seed
-        self._eliminations = {}
-        self._problem = None  # n = 5, 6: the homotopy.Problem
-        self._start = None  # and its StartSystem, loaded when first needed
+        self._eliminations: dict[bool, Elimination] = {}
+        self._problem: Problem | None = None  # n = 5, 6: the homotopy.Problem
+        self._start: StartSystem | None = None  # and its StartSystem, loaded when first needed
 
     def _elimination(self, reverse: bool) -> Elimination:
         if reverse not in self._eliminations:
             self._eliminations[reverse] = Elimination(self.chain, self.scale, reverse, self.seed)
         return self._eliminations[reverse]
 
-    def solve(self, T: np.ndarray, tol: float = 1e-9, count_complex: bool = False) -> Solution:
+    def solve(self, T: ArrayLike, tol: float = 1e-9, count_complex: bool = False) -> Solution:
         if self.chain.n >= 5:
             return self._solve_homotopy(T, tol)
         target = study_point(T)
@@ -79,11 +85,11 @@ class Solver:
         degenerate = []
         for reverse in (False, True) if n >= 2 else (False,):
             try:
-                cands = self._elimination(reverse).candidates(target, count_complex)
+                found = self._elimination(reverse).candidates(target, count_complex)
             except Degenerate as exc:
                 degenerate.append(str(exc))
                 continue
-            cands = np.array(cands, complex).reshape(-1, n)
+            cands = np.array(found, complex).reshape(-1, n)
             # points where a joint's rotation part vanishes (u = ±i, isotropic) are not displacements
             cands = cands[np.all(np.abs(1 + cands * cands) > 1e-3 * (1 + np.abs(cands) ** 2), axis=1)]
             count = len(_dedupe_complex(cands)) if count_complex else None
@@ -102,7 +108,7 @@ class Solver:
         certified = len(q) == 0 and not degenerate  # the elimination's "none" stands
         return Solution(q, err, 0, None, certified=certified, method="local search")
 
-    def _solve_homotopy(self, T, tol: float) -> Solution:
+    def _solve_homotopy(self, T: ArrayLike, tol: float) -> Solution:
         """n = 5, 6: R-chains by the 6R elimination (apair.ik.elimination6r) where it certifies its
         16 solutions, chains with one A-pair by theirs (apair.ik.elimination1a5r, 48); otherwise
         every start solution tracked to T (apair.ik.homotopy). Real solutions verified."""
@@ -126,7 +132,7 @@ class Solver:
         q, err = refine(self.chain, real, Tm, tol)
         return Solution(q, err, len(real), len(theta), certified=complete, method=method)
 
-    def _refuse_continuum(self, problem, ends, Tm: np.ndarray, tol: float) -> None:
+    def _refuse_continuum(self, problem: Problem, ends: Endpoints, Tm: NDArray[np.float64], tol: float) -> None:
         """ValueError where the pose has a curve of real solutions (a wrist singularity: two R-pair
         axes in line). Paths then end at singular points of the curve's complexification, often not
         real ones: the real part of such an endpoint, corrected onto the pose, is a real point of
@@ -144,8 +150,8 @@ class Solver:
                 )
 
 
-def _dedupe_complex(cands, tol: float = 1e-6) -> list:
-    out = []
+def _dedupe_complex(cands: NDArray[np.complex128], tol: float = 1e-6) -> list[NDArray[np.complex128]]:
+    out: list[NDArray[np.complex128]] = []
     for c in cands:
         if not any(np.max(np.abs(c - o) / (1 + np.abs(o))) < tol for o in out):
             out.append(c)

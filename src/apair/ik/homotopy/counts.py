@@ -47,8 +47,8 @@ def patterns(max_n: int = 6) -> list[str]:
     """Every pattern up to reversal (the first of p and p[::-1]), by length then alphabetically."""
     out = []
     for n in range(1, max_n + 1):
-        for p in itertools.product("AR", repeat=n):
-            p = "".join(p)
+        for letters in itertools.product("AR", repeat=n):
+            p = "".join(letters)
             if p <= p[::-1]:
                 out.append(p)
     return out
@@ -96,15 +96,15 @@ def count(pattern: str, seed: int = 0, progress=None, trace_upto: int = 0) -> di
     else:
         rng = np.random.default_rng([seed, 99])
         p1 = reachable_pose(problem, rng)
-        found = Index(problem)
+        index = Index(problem)
         for _ in range(RETRIES + 1):
             end, status = segment(problem, start.p0, p1, start.solutions, rng)
             for e in end[status == OK]:
                 if np.all(np.abs(np.exp(1j * e[problem.joints :]) - 1) <= VIRTUAL_ZERO):
-                    found.add(e)
+                    index.add(e)
             if np.all(status != FAILED):
                 break
-        found = len(found.rows)
+        found = len(index.rows)
     how = f"monodromy: {len(start.runs)} runs found {start.runs}"
     if traced:
         how += (

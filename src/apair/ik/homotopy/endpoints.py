@@ -53,8 +53,8 @@ def solve(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 0) ->
             new, row = found.place(endpoint, is_canonical=True, loose=st == SINGULAR)
             if new:
                 owner[row] = j
-            elif st == OK and owner[row] is not None:
-                missing |= {j, owner[row]}
+            elif st == OK and (first := owner[row]) is not None:
+                missing |= {j, first}
                 owner[row] = None
             elif st == OK:
                 missing.add(j)

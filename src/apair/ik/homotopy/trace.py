@@ -33,6 +33,7 @@ import dataclasses
 import math
 import time
 from dataclasses import dataclass
+from typing import Any
 
 import flint
 import numpy as np
@@ -248,7 +249,7 @@ def exact_system(problem: Problem, theta, P) -> list:
     vector part of q̄ ⊗ x with x the product of the quaternions of Rz(θ + φ) and Rx(α)."""
     zero, one = flint.acb(0), flint.acb(1)
     T = [[one if r == c else zero for c in range(4)] for r in range(3)]
-    x = (one, zero, zero, zero)
+    x: tuple[Any, ...] | np.ndarray = (one, zero, zero, zero)
     for i in range(6):
         a, alpha, c, phi = (flint.acb(float(v)) for v in problem.dh[i])
         th = theta[i] + phi
@@ -273,7 +274,7 @@ def _exact_coordinates(problem, theta) -> list:
     return [(flint.acb(0, 1 if problem.kind[j] == 0 else 0.5) * theta[j]).exp() for j in range(6)]
 
 
-def _refine(sl: Slice, X: np.ndarray) -> list:
+def _refine(sl: Slice, X: np.ndarray) -> list[list[Any] | None]:
     """The points X (k, 7) on H(·; s = 1) = 0 of a slice of the trace family, each polished by
     double-precision Newton and, where that stalls above REFINE_AT, by Newton with the residual at
     DIGITS digits (the Jacobian from the kernel): per point 7 flint.acb, or None where Newton does
@@ -289,7 +290,7 @@ def _refine(sl: Slice, X: np.ndarray) -> list:
         better = np.isfinite(d).all(1) & (np.abs(d).max(1) < step)
         X[better] += d[better]
         step[better] = np.abs(d[better]).max(1)
-    out = []
+    out: list[list[Any] | None] = []
     with flint.ctx.workdps(DIGITS):
         a = [[_acb(v) for v in row] for row in sl.ell + sl.dell]
         p, w, t = [_acb(v) for v in sl.p], [_acb(v) for v in sl.w], _acb(sl.t0 + sl.dt)
@@ -312,7 +313,8 @@ def _refine(sl: Slice, X: np.ndarray) -> list:
                     if np.abs(d).max() <= 1e-30 * size:
                         break
                 if not np.abs(d).max() <= 1e-20 * size:
-                    xm = None
+                    out.append(None)
+                    continue
             out.append(xm)
     return out
 
@@ -410,8 +412,10 @@ def _deviation(problem: Problem, p0: np.ndarray, witnesses, rng) -> float:
         for t in ts:
             sl = dataclasses.replace(base, dt=complex(t))
             X = _track_distinct(sl, X0, rng)
-            points = None if X is None else _refine(sl, X)
-            if points is None or any(x is None for x in points):
+            if X is None:
+                break
+            points = _refine(sl, X)
+            if any(x is None for x in points):
                 break
             traces.append(_trace_sum(problem, points))
             sizes.append(_sizes(problem, X))

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import os
 from concurrent.futures import ThreadPoolExecutor
+from typing import TypedDict
 
 import numpy as np
 
@@ -137,8 +138,21 @@ def _pool(threads: int) -> ThreadPoolExecutor:
     return _POOLS[threads]
 
 
-# The tracker's settings: those of apair_ik_default_options in generated/c/apair_ik.c.
-TRACK = {
+class TrackOptions(TypedDict):
+    initial_step: float
+    max_step: float
+    min_step: float
+    max_steps: int
+    corrector_steps: int
+    path_tol: float
+    final_tol: float
+    final_steps: int
+    divergence: float
+    singular_cond: float
+
+
+# The tracker's settings: those of apair_ik_default_options in src/csrc/apair_ik_track.c.
+TRACK: TrackOptions = {
     "initial_step": 0.1,
     "max_step": 0.5,
     "min_step": 1e-12,

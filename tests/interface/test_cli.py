@@ -14,7 +14,7 @@ import pytest
 import apair
 from apair.cli import main
 
-EXAMPLES = Path(__file__).parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 CHAIN2, CHAIN4 = EXAMPLES / "2a_chain.toml", EXAMPLES / "4a_chain.toml"
 NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 

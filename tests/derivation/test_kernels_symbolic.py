@@ -10,6 +10,9 @@ from conftest import evaluate_spec
 
 from apair.kernels import call, manifest
 
+# Every test here derives the kernels afresh (about a minute): the full suite only.
+pytestmark = pytest.mark.slow
+
 POINTS = 100
 
 

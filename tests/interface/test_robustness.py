@@ -111,6 +111,7 @@ def test_content_hash_covers_every_compiled_source():
         assert kernels._native()[0].sources_hash == manifest["sources_hash"]
 
 
+@pytest.mark.slow
 def test_header_hash_changes_with_the_kernel_template(monkeypatch):
     import codegen.emitter as E
     from derivations import apair_pair

@@ -17,7 +17,7 @@ import pytest
 
 from apair.cli import main as cli
 
-EXAMPLE = str(Path(__file__).resolve().parent.parent / "examples" / "2a_chain.toml")
+EXAMPLE = str(Path(__file__).resolve().parents[2] / "examples" / "2a_chain.toml")
 
 
 def codegen(out: Path, prefix: str, *extra: str) -> int:

@@ -2,7 +2,7 @@
 
 Quick checks of the structure (`make check` compares the whole of generated/ with a regeneration):
 the lowering passes on a small spec, each backend's files from its own templates, the facade
-(codegen.emitter) giving the same files, and generated/c/apair_ik.c as a copy of src/csrc/apair_ik.c.
+(codegen.emitter) giving the same files, and generated/c/apair_ik*.{c,h} as copies of src/csrc.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from codegen.lowering.order import ordered
 from codegen.lowering.symbols import local_names
 from codegen.render import render_all
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 BACKENDS = ROOT / "codegen" / "backends"
 
 
@@ -87,7 +87,7 @@ def test_each_backend_renders_from_its_own_templates():
     assert set(library.files) < set(files) and files["manifest.json"].count(library.content_hash) == 1
     assert set(numpy.render(low, library.content_hash)) == {"numpy/test.py", "numpy/__init__.py"}
     assert js.render(low["test"]) == {}  # not the viewer's kernels
-    assert "c/apair_ik.c" in files and "c/small.c" in files
+    assert "c/apair_ik_track.c" in files and "c/apair_ik_internal.h" in files and "c/small.c" in files
 
 
 def test_templates_sit_with_their_backend_and_stay_small():
@@ -102,7 +102,11 @@ def test_templates_sit_with_their_backend_and_stay_small():
 
 
 def test_hand_written_c_is_copied_verbatim():
-    source = (ROOT / "src" / "csrc" / "apair_ik.c").read_text()
-    assert "{{" not in source and "{%" not in source  # plain C, not a template
-    copy = (ROOT / "generated" / "c" / "apair_ik.c").read_text()
-    assert copy.endswith(source) and copy == c_backend.backend.copies()["apair_ik.c"]
+    copies = c_backend.backend.copies()
+    sources = sorted(p for p in (ROOT / "src" / "csrc").iterdir() if p.suffix in (".c", ".h"))
+    assert sorted(copies) == [p.name for p in sources] and "apair_ik_track.c" in copies
+    for path in sources:
+        source = path.read_text()
+        assert "{{" not in source and "{%" not in source  # plain C, not a template
+        copy = (ROOT / "generated" / "c" / path.name).read_text()
+        assert copy.endswith(source) and copy == copies[path.name]

@@ -13,7 +13,7 @@ import apair
 from apair import AChain, APair
 from apair.study import normalise
 
-EXAMPLES = Path(__file__).parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 NAN, INF = float("nan"), float("inf")
 
 

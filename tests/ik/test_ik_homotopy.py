@@ -72,6 +72,7 @@ def test_6r_has_16_solutions_and_round_trips():
             assert len(sol.q) % 2 == 0  # real solutions of a real pose come in an even number (16 is even)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pattern", ["ARRRRR", "RRARRR", "RARRR", "RRRRA"])
 def test_mixed_chains_round_trip(pattern, tracked):
     rng = np.random.default_rng(len(pattern) * 7 + pattern.index("A"))
@@ -301,6 +302,7 @@ def test_numpy_tracker_agrees_with_the_c_tracker():
     assert np.all(d < 1e-6) and np.median(d) < 1e-10  # one solution each (the worst conditioned to ~1e-7)
 
 
+@pytest.mark.slow
 def test_far_out_solutions_are_refined_in_extended_precision():
     """Solutions far out in the complex (|Im θ| > 9) at a generic pose: with the residual in
     extended precision (ik_residual6_wide) the tracker's Newton refines each to the solution that
@@ -332,6 +334,7 @@ def test_far_out_solutions_are_refined_in_extended_precision():
     assert worst[(4.0, 4.0)] < 1e-10 and worst[(np.inf, np.inf)] > 100 * worst[(4.0, 4.0)], worst
 
 
+@pytest.mark.slow
 def test_threads_track_the_same_paths(monkeypatch):
     """The paths shared among threads end where one thread takes them (bit for bit: each path is
     tracked on its own), and a bad APAIR_THREADS is refused."""
@@ -406,6 +409,7 @@ int main(void)
 """
 
 
+@pytest.mark.slow
 def test_c_api_of_the_solvers_under_sanitizers(tmp_path):
     """apair_ik_local and apair_ik_track called from C (the library built with ASan and UBSan)."""
     import shutil
@@ -414,7 +418,7 @@ def test_c_api_of_the_solvers_under_sanitizers(tmp_path):
 
     if shutil.which("gcc") is None:
         pytest.skip("gcc is required")
-    cdir = Path(__file__).resolve().parent.parent / "generated" / "c"
+    cdir = Path(__file__).resolve().parents[2] / "generated" / "c"
     prog = tmp_path / "solvers.c"
     prog.write_text(C_PROGRAM)
     exe = tmp_path / "solvers"
@@ -428,9 +432,7 @@ def test_c_api_of_the_solvers_under_sanitizers(tmp_path):
         "-fsanitize=address,undefined",
         "-fno-sanitize-recover=all",
     ]
-    sources = [str(cdir / n) for n in ("apair_ik.c", "apair_registry.c")] + sorted(
-        str(p) for p in cdir.glob("*.c") if p.name not in ("apair_ik.c", "apair_registry.c")
-    )
+    sources = sorted(str(p) for p in cdir.glob("*.c"))
     build = subprocess.run(["gcc", *flags, str(prog), *sources, "-o", str(exe), "-lm"], capture_output=True, text=True)
     if build.returncode and "sanitize" in build.stderr:
         pytest.skip("the sanitizer runtimes are not installed")

@@ -18,7 +18,7 @@ import pytest
 import apair
 from apair import cli, plots
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "4a_chain.toml"
 GENERAL = (
     '[[joint]]\npair = "general"\nbase_radius = 0.05\nplatform_radius = 0.04\nleg_length = 0.06\na = 0.1\nalpha = 0\n'
@@ -79,6 +79,7 @@ def test_workspace_plot_refused_before_the_run(tmp_path, capsys):
 
 
 # ----------------------------------------------------------------------------- item 9: codegen --out
+@pytest.mark.slow
 def test_codegen_refuses_a_folder_it_did_not_create(tmp_path):
     mine = tmp_path / "notes.txt"
     mine.write_text("keep me")
@@ -141,6 +142,7 @@ def test_folders_fifos_and_none_as_chain_files(tmp_path, capsys):
         apair.load(None)
 
 
+@pytest.mark.slow
 def test_unreachable_scheduler_and_bogus_engine(capsys):
     chain = apair.load(EXAMPLE)
     with pytest.raises(ValueError, match="^engine: expected"):

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 PAGES = [ROOT / "README.md"] + sorted(DOCS.rglob("*.md"))
 FENCE = re.compile(r"^(?P<indent>[ \t]*)```(?P<lang>[\w-]*)[^\n]*\n(?P<body>.*?)^(?P=indent)```[ \t]*$", re.M | re.S)
@@ -141,6 +141,7 @@ PAGES_WITH_CODE = [p for p in PAGES if any(runnable(b) for b in blocks(p))]
 
 
 @pytest.mark.parametrize("path", PAGES_WITH_CODE, ids=relative)
+@pytest.mark.slow
 def test_page_examples_run(path, tmp_path):
     done = run_page(path, tmp_path)
     assert done.returncode == 0, f"{relative(path)}:\n{done.stdout[-3000:]}\n{done.stderr[-6000:]}"

@@ -216,6 +216,7 @@ def test_issue_reproducer_special_4r():
     assert contains(sol.q, q, periods(chain)) and sol.certified
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("n, count", [(2, 60), (3, 120), (4, 240)])
 def test_special_designs_never_miss_a_full_rank_pose(n, count):
     """Random special designs at joint values with 0 and π: a pose that fk produced, where the

@@ -66,6 +66,7 @@ def test_slice_derivatives(times_lambda):
     assert np.abs(fd[0] - Hs[0]).max() <= 1e-7 * (1 + np.abs(Hs).max())
 
 
+@pytest.mark.slow
 def test_slice_tracker_c_matches_numpy():
     """apair_ik_track_slice and the NumPy tracker on the same slice paths: the same steps and
     endpoints (both modes: the trace family from the start set, a hyperplane move of its images)."""
@@ -88,6 +89,7 @@ def test_slice_tracker_c_matches_numpy():
         assert np.abs(c[0] - n[0]).max() <= 1e-8
 
 
+@pytest.mark.slow
 def test_trace_test_decides():
     """One witness set, three start sets: the complete one passes by many orders of magnitude,
     the one short of a solution fails, and so does the complete one against the witness set short
@@ -107,6 +109,7 @@ def test_trace_test_decides():
     assert not lacking.passed and lacking.deviation > 10 * trace.TRACE_TOL
 
 
+@pytest.mark.slow
 def test_missing_start_solutions_are_found():
     """A start set short of three solutions: the trace family's loops carry witnesses back to
     them, and the completed set passes."""
@@ -122,6 +125,7 @@ def test_missing_start_solutions_are_found():
     assert not any(index.add(x) for x in start.solutions[:3])
 
 
+@pytest.mark.slow
 def test_special_design_is_certified():
     """A UR-like arm (axes 2, 3, 4 parallel, twists of 0 and ±90°, zero lengths): 8 solutions,
     which two monodromy runs could only agree on; the trace test certifies them."""
@@ -138,6 +142,7 @@ def test_special_design_is_certified():
     assert sol.certified and np.any(np.all(np.abs((sol.q - q + PI) % (2 * PI) - PI) < 1e-7, axis=1))
 
 
+@pytest.mark.slow
 def test_verdict_is_cached_and_shown(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("APAIR_CACHE", str(tmp_path / "cache"))
     path = arm_toml(tmp_path)

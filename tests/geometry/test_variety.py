@@ -45,6 +45,7 @@ def random_poses(chain, count, seed):
     return chain.fk_study(q)
 
 
+@pytest.mark.slow
 def test_2r_is_a_quadric_in_a_3_space():
     W = chain_2r().constraint_variety()
     assert W.exact and W.degree == 2
@@ -52,6 +53,7 @@ def test_2r_is_a_quadric_in_a_3_space():
     assert all(W.hilbert[k] == (k + 1) ** 2 for k in range(7))  # a quadric surface in P^3
 
 
+@pytest.mark.slow
 def test_equations_vanish_on_poses_and_not_elsewhere(var2a):
     chain = chain_2a()
     assert var2a.exact and var2a.degree == 24
@@ -127,6 +129,7 @@ def test_variety_inputs(tmp_path):
         chain_2r().constraint_variety(max_degree=7)
 
 
+@pytest.mark.slow
 def test_cli_variety(capsys, tmp_path):
     path = tmp_path / "c.toml"
     path.write_text(
@@ -158,7 +161,7 @@ def test_example_variety_in_generated_vanishes_on_its_poses():
     xs = sp.symbols("x0 x1 x2 x3 y0 y1 y2 y3", real=True)
     fns = [sp.lambdify(xs, e, "numpy") for e in eqs.values()]
     size = np.array([sum(abs(float(c)) for c in sp.Poly(e, *xs).coeffs()) for e in eqs.values()])[:, None]
-    chain = apair.load(Path(__file__).parent.parent / "examples" / "2a_chain.toml")
+    chain = apair.load(Path(__file__).resolve().parents[2] / "examples" / "2a_chain.toml")
     rng = np.random.default_rng(5)
     S = chain.fk_study(rng.uniform(-2 * np.pi, 2 * np.pi, (1000, 2)))
     vals = np.array([f(*S.T) for f in fns]) / size  # the points have |x| = 1 and |y| < 1

@@ -14,7 +14,7 @@ import apair
 from apair.cli import main
 
 R = apair.APair.revolute
-EXAMPLES = Path(__file__).parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def arm(L1, L2):
@@ -23,6 +23,7 @@ def arm(L1, L2):
     return apair.AChain([R(), R(), R()], [0.0, L1, L2], [math.pi / 2, 0.0, 0.0])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("L1, L2", [(0.3, 0.3), (0.3, 0.2)])
 def test_volume_of_a_spherical_shell_within_its_uncertainty(L1, L2):
     exact = 4 / 3 * math.pi * ((L1 + L2) ** 3 - abs(L1 - L2) ** 3)

@@ -118,6 +118,7 @@ CHAIN = apair.AChain(
     leg_radius=values(()),
     thickness=values(()),
 )
+@pytest.mark.slow
 def test_apair_constructor(r_b, r_p, leg_length, leg_radius, thickness):
     def make():
         p = apair.APair(r_b, r_p, leg_length=leg_length, leg_radius=leg_radius, thickness=thickness)

@@ -1,0 +1,77 @@
+/*
+ * A copy of src/csrc/apair_ik_internal.h (hand-written), made by codegen/backends/c for the library in
+ * generated/c. Do not edit: edit src/csrc/apair_ik_internal.h. Content hash: 96de34dff2be99d4
+ */
+/*
+ * Private to the hand-written solvers of src/csrc (apair_ik_*.c, apair_ik4.c, apair_ik6r.c): the
+ * complex type in C and C++, and the Gaussian elimination they share (GAUSS_SOLVE). Not part of
+ * the API (not installed; apair.h declares the solvers themselves).
+ */
+#ifndef APAIR_IK_INTERNAL_H
+#define APAIR_IK_INTERNAL_H
+
+#include <math.h>
+#include <string.h>
+
+#ifdef __cplusplus /* the library also builds as C++: std::complex in place of C99's complex type */
+#include <complex>
+typedef std::complex<double> cplx;
+#define I cplx(0.0, 1.0)
+#define creal(z) std::real(z)
+#define cimag(z) std::imag(z)
+#define cabs(z) std::abs(z)
+#define cexp(z) std::exp(z)
+#define catan(z) std::atan(z)
+#define ccos(z) std::cos(z)
+#define csin(z) std::sin(z)
+#define clog(z) std::log(z)
+#define csqrt(z) std::sqrt(z)
+#define conj(z) std::conj(z)
+#else
+#include <complex.h>
+typedef double _Complex cplx;
+#endif
+
+#include "apair.h"
+#include "apair_internal.h"
+
+#define NMAX 6 /* the most joints of a chain */
+
+/* GAUSS_SOLVE(name, T, mag) defines `static int name(int n, T *A, int m, T *B)` for the scalar
+ * type T (mag: its absolute value). It solves A X = B (A n x n, row-major, overwritten; B n x m,
+ * row-major, becomes X) by Gaussian elimination with partial pivoting. Returns 0, or -1 if a pivot
+ * is zero or not finite. Each file defines the solvers it calls (static: the compiler inlines them
+ * where it pays, as in one file). */
+#define GAUSS_SOLVE(name, T, mag) \
+    static int name(int n, T *A, int m, T *B) \
+    { \
+        for (int k = 0; k < n; k++) { \
+            int p = k; \
+            double best = mag(A[k * n + k]); \
+            for (int r = k + 1; r < n; r++) { \
+                double a = mag(A[r * n + k]); \
+                if (a > best) { best = a; p = r; } \
+            } \
+            if (!(best > 0.0) || !isfinite(best)) return -1; \
+            if (p != k) { \
+                for (int c = 0; c < n; c++) { T t = A[k * n + c]; A[k * n + c] = A[p * n + c]; A[p * n + c] = t; } \
+                for (int j = 0; j < m; j++) { T t = B[k * m + j]; B[k * m + j] = B[p * m + j]; B[p * m + j] = t; } \
+            } \
+            T inv = 1.0 / A[k * n + k]; \
+            for (int r = k + 1; r < n; r++) { \
+                T f = A[r * n + k] * inv; \
+                if (f == 0.0) continue; \
+                for (int c = k + 1; c < n; c++) A[r * n + c] -= f * A[k * n + c]; \
+                for (int j = 0; j < m; j++) B[r * m + j] -= f * B[k * m + j]; \
+            } \
+        } \
+        for (int k = n - 1; k >= 0; k--) \
+            for (int j = 0; j < m; j++) { \
+                T s = B[k * m + j]; \
+                for (int c = k + 1; c < n; c++) s -= A[k * n + c] * B[c * m + j]; \
+                B[k * m + j] = s / A[k * n + k]; \
+            } \
+        return 0; \
+    }
+
+#endif
