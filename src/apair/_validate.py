@@ -3,21 +3,54 @@
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 MAX_DIMS = 24  # batch axes plus a kernel's own (at most 3) stay within NumPy's 32 (and 64) dimensions
+
+
+# The range apair computes in: every length [m], mass [kg] and acceleration [m/s²] is 0 or of
+# magnitude in [1e-40, 1e40]; inertias [kg m²] in [1e-120, 1e120]. Products of a few of them (a mass
+# matrix entry: mass × length²; a volume: length³) then stay normal doubles, so every finite input
+# gives finite output (docs/conventions.md, "Units and ranges").
+LENGTH_RANGE = (1e-40, 1e40)
+INERTIA_RANGE = (1e-120, 1e120)
+
+
+def in_range(name: str, value: ArrayLike, unit: str, bounds: tuple[float, float] = LENGTH_RANGE) -> None:
+    """Refuses an entry that is neither 0 nor of magnitude within bounds, naming it and the range."""
+    lo, hi = bounds
+    arr = np.asarray(value, float)
+    mag = np.abs(arr)
+    bad = (mag != 0) & ((mag < lo) | (mag > hi))
+    if bad.any():
+        at = tuple(int(i) for i in np.argwhere(bad)[0])
+        where = f"[{', '.join(map(str, at))}]" if at else ""
+        raise ValueError(
+            f"{name}{where}: {float(arr[at]):.6g} {unit} is outside the range apair computes in "
+            f"(0, or {lo:g} to {hi:g} {unit} in magnitude)"
+        )
+
+
+def shorten(text: str, limit: int = 80) -> str:
+    """One line of at most `limit` characters, for a value quoted in an error message."""
+    line = " ".join(text.split())
+    return line if len(line) <= limit else line[: limit - 3] + "..."
 
 
 def real_array(
     name: str, value: object, *, trailing: tuple[int, ...] | None = None, ndim_max: int | None = None
 ) -> NDArray[np.float64]:
     """A finite float64 array; `trailing` fixes the last axes' shape."""
+    if isinstance(value, np.ma.MaskedArray):
+        raise ValueError(f"{name}: masked arrays are not accepted (the mask would be ignored); pass plain values")
     try:
         raw = np.asarray(value)
     except (TypeError, ValueError, OverflowError, RecursionError) as exc:
-        raise ValueError(f"{name}: expected an array of real numbers ({type(exc).__name__}: {exc})") from None
+        raise ValueError(
+            f"{name}: expected an array of real numbers ({type(exc).__name__}: {shorten(str(exc))})"
+        ) from None
     if raw.dtype.kind not in "iuf":  # no booleans, complex numbers, strings or objects
-        raise ValueError(f"{name}: expected real numbers, got {raw.dtype.name} values {value!r}")
+        raise ValueError(f"{name}: expected real numbers, got {raw.dtype.name} values {shorten(repr(value))}")
     arr = raw.astype(np.float64, copy=False)
     if trailing is not None:
         k = len(trailing)
@@ -54,9 +87,24 @@ def vector(name: str, value: object, n: int) -> NDArray[np.float64]:
     return arr
 
 
-def integer(name: str, value: object, minimum: int = 1) -> int:
-    """An integer ≥ minimum; a float is accepted only when it is a whole number (8.9 is refused,
-    not truncated)."""
+def flag(name: str, value: object) -> bool:
+    """A bool (numpy's too): 'no', 0 or None are refused, not read as true or false."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name}: expected True or False, got {shorten(repr(value))}")
+    return bool(value)
+
+
+SEED_MAX = 2**63 - 1
+
+
+def seed(value: object, name: str = "seed") -> int:
+    """A random seed: an integer in [0, 2**63 - 1] (None is refused: results are reproducible)."""
+    return integer(name, value, minimum=0, maximum=SEED_MAX)
+
+
+def integer(name: str, value: object, minimum: int = 1, maximum: int | None = None) -> int:
+    """An integer in [minimum, maximum]; a float is accepted only when it is a whole number (8.9 is
+    refused, not truncated). Every count a user passes has a maximum: the work it asks for."""
     if isinstance(value, (bool, np.bool_)):
         raise ValueError(f"{name}: expected an integer, got {value!r}")
     if isinstance(value, (int, np.integer)):
@@ -64,8 +112,10 @@ def integer(name: str, value: object, minimum: int = 1) -> int:
     else:
         x = scalar(name, value)
         if x != int(x):
-            raise ValueError(f"{name}: expected an integer, got {value!r}")
+            raise ValueError(f"{name}: expected an integer, got {shorten(repr(value))}")
         out = int(x)
     if out < minimum:
         raise ValueError(f"{name}: must be >= {minimum}, got {out}")
+    if maximum is not None and out > maximum:
+        raise ValueError(f"{name}: must be <= {maximum}, got {shorten(str(out))}")
     return out

@@ -34,6 +34,7 @@ if TYPE_CHECKING:
     from .workspace import Workspace
 
 MAX_JOINTS = 6
+MAX_ITER = 100_000  # ik_local: Levenberg-Marquardt steps per seed, a bound on the work asked for
 # The kernel-backed methods in the order of their native fast path (apair.kernels.native_chain):
 # (kernel family, whether a joint at its range end is refused because d' is unbounded there).
 METHODS = (
@@ -71,7 +72,7 @@ class AChain:
         try:
             pair_list = list(pairs)
         except TypeError as exc:
-            raise ValueError(f"pairs: expected a sequence of APair, got {pairs!r}") from exc
+            raise ValueError(f"pairs: expected a sequence of APair, got {V.shorten(repr(pairs))}") from exc
         n = len(pair_list)
         if not 1 <= n <= MAX_JOINTS:
             raise ValueError(f"pairs: a chain has 1 to {MAX_JOINTS} pairs, got {n}")
@@ -83,13 +84,15 @@ class AChain:
         self.alpha = V.vector("alpha", alpha, n)
         self.offset = np.zeros(n) if offset is None else V.vector("offset", offset, n)
         self.theta_offset = np.zeros(n) if theta_offset is None else V.vector("theta_offset", theta_offset, n)
+        V.in_range("a", self.a, "m")
+        V.in_range("offset", self.offset, "m")
         self._dh = np.ascontiguousarray(np.stack([self.a, self.alpha, self.offset, self.theta_offset], axis=1))
         if links is None:
             links = [Link(0.0) for _ in range(n)]
         try:
             link_list = list(links)
         except TypeError as exc:
-            raise ValueError(f"links: expected a sequence of Link, got {links!r}") from exc
+            raise ValueError(f"links: expected a sequence of Link, got {V.shorten(repr(links))}") from exc
         if len(link_list) != n:
             raise ValueError(f"links: expected {n} links (one per pair), got {len(link_list)}")
         for i, link in enumerate(link_list):
@@ -97,6 +100,7 @@ class AChain:
                 raise ValueError(f"links[{i}]: expected a Link, got {type(link).__name__}")
         self.links: list[Link] = link_list
         self.gravity = V.vector("gravity", gravity, 3)
+        V.in_range("gravity", self.gravity, "m/s^2")
         self._links = np.ascontiguousarray(np.stack([link.as_row() for link in links]))
         self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pair_list])
         self._gravity = np.ascontiguousarray(self.gravity)
@@ -126,7 +130,7 @@ class AChain:
         try:
             entries = list(limits)
         except TypeError as exc:
-            raise ValueError(f"limits: expected one (lo, hi) or None per pair, got {limits!r}") from exc
+            raise ValueError(f"limits: expected one (lo, hi) or None per pair, got {V.shorten(repr(limits))}") from exc
         if len(entries) != self.n:
             raise ValueError(f"limits: expected {self.n} entries (one per pair), got {len(entries)}")
         out: list[tuple[float, float] | None] = []
@@ -345,6 +349,7 @@ class AChain:
         Written to `path` too if given (an existing file only with overwrite=True). Returns the XML."""
         from . import mjcf
 
+        collisions = V.flag("collisions", collisions)
         xml = mjcf.to_mjcf(self, q, name=getattr(self, "name", None) or "apair chain", collisions=collisions)
         if path is not None:
             write_text(path, xml, overwrite, ".xml")
@@ -394,9 +399,8 @@ class AChain:
         """
         from .variety import constraint_variety
 
-        if not isinstance(max_degree, int) or not 1 <= max_degree <= 4:
-            raise ValueError(f"max_degree: expected an integer from 1 to 4, got {max_degree!r}")
-        return constraint_variety(self, max_degree=max_degree, seed=seed)
+        max_degree = V.integer("max_degree", max_degree, minimum=1, maximum=4)
+        return constraint_variety(self, max_degree=max_degree, seed=V.seed(seed))
 
     # ----------------------------------------------------------------------------- inverse kinematics
     @overload
@@ -434,6 +438,7 @@ class AChain:
         from .ik import Solver
 
         tol = V.scalar("tol", tol, positive=True)
+        full, within_limits = V.flag("full", full), V.flag("within_limits", within_limits)
         if self._ik is None:
             self._ik = Solver(self)
         sol = self._ik.solve(T, tol=tol, count_complex=full)
@@ -476,7 +481,7 @@ class AChain:
         (q, residual = largest entry of |fk(q) − T|, converged = residual ≤ tol). Any n, any pairs."""
         from .ik import ik_local
 
-        return ik_local(self, T, q0, tol=tol, max_iter=max_iter)
+        return ik_local(self, T, q0, tol=tol, max_iter=V.integer("max_iter", max_iter, maximum=MAX_ITER))
 
     def workspace(
         self,
@@ -499,9 +504,9 @@ class AChain:
             samples=samples,
             resolution=resolution,
             rounds=rounds,
-            poses=poses,
+            poses=V.flag("poses", poses),
             engine=engine,
-            seed=seed,
+            seed=V.seed(seed),
             progress=progress,
         )
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import sys
 from collections.abc import Callable, Sequence
 from typing import cast
@@ -226,7 +227,7 @@ def _cmd_limits(args: argparse.Namespace) -> int:
     for i, p in enumerate(chain.pairs):
         what = "explicit" if chain._explicit_limits[i] is not None else p.collision_limits().what
         print(f"  joint {i + 1}: {np.degrees(lim[i, 0]):+10.4f} .. {np.degrees(lim[i, 1]):+10.4f}   {what}")
-    if args.plot:
+    if args.plot is not None:  # an empty name is refused, not ignored
         from .plots import clearance
 
         k = next((i for i, p in enumerate(chain.pairs) if p.kind != "revolute"), None)
@@ -240,7 +241,7 @@ def _cmd_workspace(args: argparse.Namespace) -> int:
     from .workspace import text_progress
 
     chain = load(args.file)
-    if args.plot:
+    if args.plot is not None:  # an empty name is refused, not ignored
         from .files import target
 
         target(args.plot, args.force)  # refuse before the long run, not after it
@@ -259,7 +260,7 @@ def _cmd_workspace(args: argparse.Namespace) -> int:
         f"  bounding box [m]: x {lo[0]:+.4f} .. {hi[0]:+.4f}, y {lo[1]:+.4f} .. {hi[1]:+.4f}, "
         f"z {lo[2]:+.4f} .. {hi[2]:+.4f}"
     )
-    if args.plot:
+    if args.plot is not None:
         print(f"  picture written to {ws.plot(args.plot, overwrite=args.force)}")
     return 0
 
@@ -284,8 +285,10 @@ def _cmd_view(args: argparse.Namespace) -> int:
     from . import view
 
     chain = load(args.file)
-    if args.workspace < 0:
-        raise ValueError(f"--workspace: expected a number of samples >= 0, got {args.workspace}")
+    if not 0 <= args.workspace <= view.MAX_WORKSPACE_POINTS:
+        raise ValueError(
+            f"--workspace: expected a number of samples from 0 to {view.MAX_WORKSPACE_POINTS}, got {args.workspace}"
+        )
     out = view.write(chain, args.out, overwrite=args.force, workspace=args.workspace)
     print(f"{chain.name}: viewer written to {out} (open it in a browser; it needs no network)")
     return 0
@@ -321,8 +324,20 @@ def _cmd_codegen(args: argparse.Namespace) -> int:
     return 0
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser that takes every negative number as a value, exponent form included
+    (`-1e-3`, `-2.5E+4`, `-inf`): the standard one reads those as unknown options."""
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+        self._negative_number_matcher = _NEGATIVE_NUMBER
+
+
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="apair", description="Kinematics of A-pairs and A-chains.")
+    ap = _Parser(prog="apair", description="Kinematics of A-pairs and A-chains.")
     ap.add_argument("--version", action="version", version=f"apair {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
     p = sub.add_parser("list", help="list the derived polynomial sets")
@@ -336,7 +351,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--json", action="store_true", help="the machine-readable form")
     p.set_defaults(func=_cmd_show)
     p = sub.add_parser("fk", help="forward kinematics of a chain file at joint angles Q")
-    p.add_argument("file", help="a chain TOML file (see README)")
+    p.add_argument("file", help="a chain TOML file (docs/reference/chain-files.md)")
     p.add_argument("q", nargs="+", metavar="Q", help="joint angles (radians unless --deg)")
     p.add_argument("--deg", action="store_true", help="angles in degrees")
     p.set_defaults(func=_cmd_fk)

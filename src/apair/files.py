@@ -18,22 +18,37 @@ from functools import cache
 from importlib import resources
 from pathlib import Path
 
+from ._validate import flag, shorten
 from ._version import __version__
+
+_KINDS = {".png": "a PNG picture", ".gif": "a GIF animation", ".xml": "an XML model", ".html": "an HTML page"}
 
 
 def target(path: str | os.PathLike[str], overwrite: bool, suffix: str = ".png") -> Path:
-    """The file a picture goes to, checked before any work: `suffix` is added when the name has
-    none (so the file checked is the file written), a folder is refused, and so is an existing
-    file or any symlink (dangling ones too) unless overwrite=True."""
+    """The file an output goes to, checked before any work, by one rule for every command: the
+    name as given must not be empty, a folder or anything but a regular file (a device such as
+    /dev/null included); `suffix` is added when the name has none (so the file checked is the file
+    written); an existing file or any symlink (dangling ones too) is refused unless overwrite=True."""
+    overwrite = flag("overwrite", overwrite)
     if not isinstance(path, (str, os.PathLike)):
-        raise ValueError(f"path: expected a file name, got {path!r}")
-    p = Path(path)
+        raise ValueError(f"path: expected a file name, got {shorten(repr(path))}")
+    given = os.fspath(path)
+    if not isinstance(given, str) or given.strip() == "":
+        raise ValueError(f"path: expected a file name, got {shorten(repr(given))}")
+    p = Path(given)
+    if p.is_dir() or given.endswith(("/", os.sep)) or p.name in ("", ".", ".."):
+        raise ValueError(f"path: {given!r} is a folder; give a file name in it")
+    if p.exists() and not p.is_file():
+        raise ValueError(f"path: {given!r} is not a regular file")
     if p.suffix == "":
         p = p.with_suffix(suffix)
     if p.suffix.lower() != suffix:
-        raise ValueError(f"path: {str(p)!r} must end in {suffix} (the picture is written as {suffix[1:].upper()})")
+        kind = _KINDS.get(suffix, f"a {suffix[1:].upper()} file")
+        raise ValueError(f"path: {str(p)!r} must end in {suffix} (the output is {kind})")
     if p.is_dir():
         raise ValueError(f"path: {str(p)!r} is a folder")
+    if p.exists() and not p.is_file() and not p.is_symlink():
+        raise ValueError(f"path: {str(p)!r} is not a regular file")
     if (p.exists() or p.is_symlink()) and not overwrite:
         raise ValueError(f"path: {str(p)!r} exists; pass overwrite=True (or --force) to replace it")
     if not p.parent.is_dir():
@@ -57,7 +72,10 @@ def write(p: Path, overwrite: bool, save: Callable[[str], object]) -> Path:
     """save(tmp) writes the picture to a new file beside p, which then becomes p: copied into a
     file created exclusively (what appeared in between is never replaced), or, with overwrite,
     renamed over p (a symlink is replaced itself; what it pointed to is never written)."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}-", suffix=p.suffix, dir=p.parent)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}-", suffix=p.suffix, dir=p.parent)
+    except OSError as exc:
+        raise ValueError(f"path: cannot write in folder {str(p.parent)!r} ({exc.strerror})") from None
     os.close(fd)
     try:
         save(tmp)
@@ -68,7 +86,7 @@ def write(p: Path, overwrite: bool, save: Callable[[str], object]) -> Path:
             try:
                 out = open(p, "xb")  # exclusive: never replaces what is there
             except FileExistsError:
-                raise ValueError(f"path: {str(p)!r} appeared while the picture was drawn; not replaced") from None
+                raise ValueError(f"path: {str(p)!r} appeared while the output was made; not replaced") from None
             with out, open(tmp, "rb") as src:
                 shutil.copyfileobj(src, out)
     finally:

@@ -23,6 +23,8 @@ from typing import Any, Protocol, TypedDict
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._validate import shorten
+
 _BACKENDS = ("c", "numpy")
 
 
@@ -81,7 +83,7 @@ def set_backend(name: str | None) -> None:
     """Choose "c" or "numpy" for every later kernel call (None: the default, which reads
     APAIR_BACKEND again and otherwise takes C when present)."""
     if name is not None and name not in _BACKENDS:
-        raise ValueError(f"backend: expected one of {_BACKENDS} or None, got {name!r}")
+        raise ValueError(f"backend: expected one of {_BACKENDS} or None, got {shorten(repr(name))}")
     if name == "c" and not c_available():
         raise ValueError(f"backend: 'c' requested but {_native()[1]}")
     _state["backend"] = name
@@ -110,7 +112,7 @@ def _resolve_backend() -> str:
     choice = _state["backend"] or os.environ.get("APAIR_BACKEND") or None
     if choice is not None:
         if choice not in _BACKENDS:
-            raise ValueError(f"APAIR_BACKEND: expected one of {_BACKENDS}, got {choice!r}")
+            raise ValueError(f"APAIR_BACKEND: expected one of {_BACKENDS}, got {shorten(repr(choice))}")
         if choice == "c" and not c_available():
             raise ValueError(f"APAIR_BACKEND: 'c' requested but {_native()[1]}")
         return choice
@@ -134,7 +136,7 @@ def _c_index(native: ModuleType, name: str) -> int:
     try:
         return _c_table(native)[name]
     except KeyError:
-        raise ValueError(f"kernel: no generated kernel called {name!r}") from None
+        raise ValueError(f"kernel: no generated kernel called {shorten(repr(name))}") from None
 
 
 @cache

@@ -17,10 +17,13 @@ class Link:
 
     def __init__(self, mass: ArrayLike, com: ArrayLike = (0.0, 0.0, 0.0), inertia: ArrayLike | None = None) -> None:
         self.mass = V.scalar("mass", mass, nonnegative=True)
+        V.in_range("mass", self.mass, "kg")
         self.com = V.vector("com", com, 3)
+        V.in_range("com", self.com, "m")
         I = np.zeros((3, 3)) if inertia is None else V.real_array("inertia", inertia)
         if I.shape != (3, 3):
             raise ValueError(f"inertia: expected shape (3, 3), got {I.shape}")
+        V.in_range("inertia", I, "kg m^2", V.INERTIA_RANGE)
         scale = max(1.0, float(np.max(np.abs(I))))
         if np.max(np.abs(I - I.T)) > _SYM_TOL * scale:
             raise ValueError("inertia: must be symmetric")

@@ -11,6 +11,8 @@ from typing import Any
 import sympy as sp
 from sympy.parsing.sympy_parser import parse_expr
 
+from ._validate import shorten
+
 
 def _dir() -> Traversable:
     return resources.files("apair.generated").joinpath("polynomials")
@@ -24,14 +26,14 @@ def names() -> list[str]:
 @cache
 def raw(name: str) -> dict[str, Any]:
     if name not in names():
-        raise ValueError(f"name: no derived polynomial set {name!r}; known: {', '.join(names())}")
+        raise ValueError(f"name: no derived polynomial set {shorten(repr(name))}; known: {', '.join(names())}")
     return json.loads(_dir().joinpath(f"{name}.json").read_text())
 
 
 def text(name: str, fmt: str = "txt") -> str:
     """The rendered text ("txt") or LaTeX ("tex") of a set."""
     if fmt not in ("txt", "tex"):
-        raise ValueError(f"fmt: expected 'txt' or 'tex', got {fmt!r}")
+        raise ValueError(f"fmt: expected 'txt' or 'tex', got {shorten(repr(fmt))}")
     raw(name)
     return _dir().joinpath(f"{name}.{fmt}").read_text()
 

@@ -82,7 +82,7 @@ def simulate(
     V.scalar("rtol", rtol, positive=True)
     V.scalar("atol", atol, positive=True)
     if not isinstance(limits, str) or limits not in ("stop", "ignore"):
-        raise ValueError(f"limits: expected 'stop' or 'ignore', got {limits!r}")
+        raise ValueError(f"limits: expected 'stop' or 'ignore', got {V.shorten(repr(limits))}")
     bounds = _bounds(chain, limits)
     for i, (lo, hi) in enumerate(bounds):
         if not lo <= q0[i] <= hi:

@@ -13,6 +13,7 @@ import hashlib
 import keyword
 import os
 import re
+import sys
 from collections.abc import Iterable, Sequence
 from importlib import resources
 from pathlib import Path
@@ -22,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ._validate import shorten
 from .files import cache_root, toolkit_digest
 
 if TYPE_CHECKING:
@@ -65,15 +67,31 @@ def content_hash(chain: ChainLike, kernels: Iterable[str]) -> str:
     return h.hexdigest()[:16]
 
 
+# Names a prefix must not take: the generated NAME.py beside NAME.h would shadow a module of Python's
+# standard library (the generated code imports numpy, numpy imports os, sys, math, ...) or a
+# third-party module it imports; NAME.h would shadow a standard C or POSIX header on an include path.
+_C_HEADERS = (
+    "assert complex ctype errno fenv float inttypes iso646 limits locale math setjmp signal stdalign stdarg "
+    "stdatomic stdbool stddef stdint stdio stdlib stdnoreturn string tgmath threads time uchar wchar wctype "
+    "unistd fcntl dlfcn pthread strings alloca malloc memory features endian"
+).split()
+_TAKEN_NAMES = frozenset(n.lower() for n in (*sys.stdlib_module_names, "numpy", "ctypes", "apair", *_C_HEADERS))
+
+
 def check_prefix(name: str) -> str:
     """A prefix usable as C identifier stem and Python module name, or a ValueError."""
     if not isinstance(name, str) or not _IDENT.match(name) or len(name) > 48:
         raise ValueError(
             f"prefix: expected a C identifier (letters, digits, _; not starting with a digit; at most "
-            f"48 characters), got {name!r}"
+            f"48 characters), got {shorten(repr(name))}"
         )
     if name in _C_KEYWORDS or keyword.iskeyword(name) or name.startswith("apair"):
         raise ValueError(f"prefix: {name!r} is a C, C++ or Python keyword or apair's own prefix")
+    if name.lower() in _TAKEN_NAMES:
+        raise ValueError(
+            f"prefix: {name!r} would shadow a module Python or the generated code imports, or a standard "
+            f"C header, when the output folder is on the import or include path; choose another name"
+        )
     return name
 
 
@@ -82,7 +100,10 @@ def prefix_from(path: str | os.PathLike[str]) -> str:
     stem = re.sub(r"[^A-Za-z0-9_]", "_", Path(path).stem) or "chain"
     if stem[0].isdigit():
         stem = "chain_" + stem
-    return check_prefix(stem[:48])
+    stem = stem[:42]
+    if stem.lower() in _TAKEN_NAMES or stem in _C_KEYWORDS or keyword.iskeyword(stem) or stem.startswith("apair"):
+        stem = "chain_" + stem  # math.toml gives chain_math, not a math.h beside the user's code
+    return check_prefix(stem)
 
 
 def check_kernels(kernels: Iterable[str] | None) -> tuple[str, ...]:

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from . import _validate as V
 from . import collisions
 from .files import write_text
 
@@ -26,6 +27,7 @@ if TYPE_CHECKING:
     from ._typing import ChainLike, PairLike
 
 CLEARANCE_STEP = np.radians(0.25)  # the clearance table's spacing in θ
+MAX_WORKSPACE_POINTS = 1_000_000  # sampled end points in the page: about 25 MB of it
 
 
 def _kernels_js() -> str:
@@ -81,9 +83,8 @@ def chain_data(chain: ChainLike, workspace: int = 0, seed: int = 0) -> dict[str,
 
 def to_html(chain: ChainLike, workspace: int = 0) -> str:
     """The viewer page of the chain (see the module's docstring)."""
-    if not isinstance(workspace, (int, np.integer)) or isinstance(workspace, bool) or workspace < 0:
-        raise ValueError(f"workspace: expected a number of samples >= 0, got {workspace!r}")
-    data = json.dumps(chain_data(chain, int(workspace)), separators=(",", ":"))
+    workspace = V.integer("workspace", workspace, minimum=0, maximum=MAX_WORKSPACE_POINTS)
+    data = json.dumps(chain_data(chain, workspace), separators=(",", ":"))
     page = _page_template()
     title = getattr(chain, "name", None) or "apair chain"
     return (
