@@ -109,6 +109,9 @@ def contact_polynomials(
     import flint
 
     vals = [Fraction(v) for v in (r_b, r_p, rho, tau)]
+    for name, v in zip(("r_b", "r_p"), vals):  # a zero radius would leave pieces with no term at all
+        if not v > 0:
+            raise ValueError(f"{name}: expected a radius > 0, got {float(v)!r}")
     a, b = Fraction(a), Fraction(b)
     one_t2 = flint.fmpq_poly([1, 0, 1])
     cn, sn = flint.fmpq_poly([1, 0, -1]), flint.fmpq_poly([0, 2])
@@ -203,18 +206,75 @@ def _rational(x: float) -> Fraction:
     return Fraction(x).limit_denominator(10**12)
 
 
+def _unit_length(x: float) -> float:
+    """A length in units of the pair's size, put to 0 where it is below 1e-15 (the rationals of
+    `_rational` round it to 0 anyway, and 1e-151 would be refused as a length)."""
+    return x if x >= 1e-15 else 0.0
+
+
 def unit_pair(pair: P) -> P:
     """The same pair (an APair, made by its own class) in units of its size r_b + r_p (collision
-    angles do not depend on scale)."""
+    angles do not depend on scale). Call `check_design` first: it bounds the radii's ratio, so that
+    both unit radii are lengths the pair accepts."""
     s = pair.base_radius + pair.platform_radius
     L1 = None if pair.kind == "sinusoidal" else pair.leg_lengths[0] / s
     return type(pair)(
         pair.base_radius / s,
         pair.platform_radius / s,
         leg_length=L1,
-        leg_radius=pair.leg_radius / s,
-        thickness=pair.thickness / s,
+        leg_radius=_unit_length(pair.leg_radius / s),
+        thickness=_unit_length(pair.thickness / s),
     )
+
+
+# The designs whose touches the tolerance _TOUCH_RTOL resolves (found by sweeps: a radius of 1e-9 of
+# the size, or legs of 10^3.75 sizes, give wrong limits); anything beyond is refused, not guessed.
+RATIO_MIN = 1e-6  # smallest radius / (r_b + r_p)
+LEG_RATIO_MAX = 1e3  # largest leg_length / (r_b + r_p)
+
+
+def check_design(pair: PairLike) -> None:
+    """Refuses (ValueError naming the parameter, with the values the user gave) an A-pair whose
+    collision limits do not exist or cannot be found: legs or plates that overlap at θ = 0 (the
+    pair cannot move), or proportions (triangles too unequal, legs too long) that the touch
+    tolerance cannot resolve. Cheap (no polynomials): chain files are checked with it on loading."""
+    if pair.kind == "revolute":
+        return
+    _check_proportions(pair)
+    pts = pair.leg_endpoints(0.0)
+    i, j = np.array(LEG_PAIRS).T
+    dist = segment_distance(pts[i, 0], pts[i, 1], pts[j, 0], pts[j, 1])
+    k = int(np.argmin(dist))
+    if dist[k] <= 2 * pair.leg_radius:
+        raise ValueError(
+            f"leg_radius: {pair.leg_radius!r} m is too large, legs {LEG_PAIRS[k][0] + 1} and {LEG_PAIRS[k][1] + 1} "
+            f"overlap at theta = 0 (the pair cannot move); the largest radius is {dist[k] / 2:.6g} m"
+        )
+    d0 = pair.translation(0.0)
+    if d0 <= pair.thickness:
+        raise ValueError(
+            f"thickness: {pair.thickness!r} m is not less than d(0) = {d0:.6g} m, "
+            f"the plates overlap at theta = 0 (the pair cannot move)"
+        )
+
+
+def _check_proportions(pair: PairLike) -> None:
+    """Refuses radii or a leg length outside RATIO_MIN, LEG_RATIO_MAX, naming the user's values."""
+    radii = {"base_radius": pair.base_radius, "platform_radius": pair.platform_radius}
+    size = sum(radii.values())
+    for key, value in radii.items():
+        other = "platform_radius" if key == "base_radius" else "base_radius"
+        if value < RATIO_MIN * size:
+            raise ValueError(
+                f"{key}: {value!r} m against {other} = {radii[other]!r} m: the collision limits of triangles "
+                f"this unequal (a radius below {RATIO_MIN:g} of their sum) cannot be resolved"
+            )
+    L1 = float(pair.leg_lengths[0])
+    if pair.kind == "general" and L1 > LEG_RATIO_MAX * size:
+        raise ValueError(
+            f"leg_length: {L1!r} m is more than {LEG_RATIO_MAX:g} times base_radius + platform_radius "
+            f"({size:.6g} m): the collision limits of legs this long cannot be resolved"
+        )
 
 
 def limits(pair: PairLike) -> CollisionLimits:
@@ -222,19 +282,7 @@ def limits(pair: PairLike) -> CollisionLimits:
     in units of its size, so that the answer is the same at every scale."""
     if pair.kind == "revolute":
         return CollisionLimits(-math.inf, math.inf, "none")
-    size = pair.base_radius + pair.platform_radius
-    legs0, plate0 = clearances(pair, np.array(0.0))
-    if legs0.min() <= 0:
-        i, j = LEG_PAIRS[int(np.argmin(legs0))]
-        raise ValueError(
-            f"leg_radius: {pair.leg_radius} is too large, legs {i + 1} and {j + 1} overlap at theta = 0 "
-            f"(the pair cannot move); the largest radius is {(legs0.min() + 2 * pair.leg_radius) / 2:.6g}"
-        )
-    if plate0 <= 0:
-        raise ValueError(
-            f"thickness: {pair.thickness} is not less than d(0) = {pair.translation(0.0):.6g}, "
-            f"the plates overlap at theta = 0 (the pair cannot move)"
-        )
+    check_design(pair)
     end = pair.theta_limit  # the range end of the pair itself (the unit pair's differs by rounding)
     pair, size = unit_pair(pair), 1.0
     r_b, r_p = _rational(pair.base_radius), _rational(pair.platform_radius)

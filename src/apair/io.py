@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import os
+import reprlib
 import tomllib
 from collections.abc import Sequence
 from pathlib import Path
@@ -32,7 +33,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .chain import AChain
+from . import _validate as V
+from .chain import MAX_JOINTS, AChain
+from .collisions import check_design
 from .link import Link
 from .pair import KINDS, APair
 
@@ -45,7 +48,18 @@ _DH_KEYS = {"a", "alpha", "alpha_deg", "offset", "theta_offset", "theta_offset_d
 _LINK_KEYS = {"mass", "com", "inertia"}
 
 
+def _fits(v: object, shape: tuple[int, ...]) -> bool:
+    """Whether v is nested lists of exactly this shape; looks at no more entries than the shape
+    has, so a list of a million entries costs no more than a short one."""
+    if not shape:
+        return not isinstance(v, (list, tuple))
+    return isinstance(v, (list, tuple)) and len(v) == shape[0] and all(_fits(x, shape[1:]) for x in v)
+
+
 def _numbers(where: str, v: object, shapes: Sequence[tuple[int, ...]]) -> NDArray[np.float64]:
+    if not any(_fits(v, shape) for shape in shapes):  # sizes first: nothing is converted before
+        size = f" of {len(v)} entries" if isinstance(v, (list, tuple)) else ""
+        raise ValueError(f"{where}: expected numbers of shape {' or '.join(map(str, shapes))}, got {_short(v)}{size}")
     try:
         arr = np.asarray(v, dtype=object)
     except ValueError:  # ragged nesting
@@ -94,7 +108,10 @@ def _limits(where: str, j: dict[str, Any], pair: APair) -> tuple[float, float] |
             lo, hi = _numbers(f"{where}.{key}", j[key], [(2,)])
             if not lo < hi:
                 raise ValueError(f"{where}.{key}: expected lo < hi, got ({lo:g}, {hi:g}) {unit}")
-            plo, phi = pair.motion_range()
+            try:
+                plo, phi = pair.motion_range()
+            except ValueError as exc:
+                raise ValueError(f"{where}.{exc}") from None
             if lo * scale < plo or hi * scale > phi:
                 raise ValueError(
                     f"{where}.{key}: ({lo:g}, {hi:g}) {unit} goes beyond the pair's collision-free "
@@ -116,52 +133,70 @@ def _number(where: str, v: object) -> float:
     return x
 
 
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxlist, _REPR.maxtuple, _REPR.maxdict, _REPR.maxstring, _REPR.maxother = 3, 6, 6, 4, 40, 40
+
+
 def _short(v: object, limit: int = 60) -> str:
-    """repr(v), cut to `limit` characters (a value in an error message, not a dump)."""
-    text = repr(v)
+    """repr(v), cut to `limit` characters (a value in an error message, not a dump); reprlib's, so
+    that a list of a million entries costs no more than a short one."""
+    text = _REPR.repr(v)
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
+def _pair(w: str, j: dict[str, Any], kind: str) -> APair:
+    """Joint j's pair, with the design checks that later commands would otherwise fail on
+    (legs or plates that overlap: `check_design`), named by the file's keys."""
+    if kind == "revolute":
+        return APair.revolute()
+    kw = {k: _number(f"{w}.{k}", j[k]) for k in _PAIR_KEYS[kind] if k in j}
+    for req in ("base_radius", "platform_radius") + (("leg_length",) if kind == "general" else ()):
+        if req not in kw:
+            raise ValueError(f"{w}: missing {req}")
+    try:
+        pair = APair(**kw)
+        check_design(pair)
+    except ValueError as exc:
+        raise ValueError(f"{w}.{exc}") from None
+    return pair
+
+
+def _joint(w: str, j: object) -> tuple[APair, float, float, float, float, Link]:
+    """(pair, a, alpha, offset, theta_offset, link) of one [[joint]] table."""
+    if not isinstance(j, dict):
+        raise ValueError(f"{w}: expected a [[joint]] table, got {_short(j)}")
+    kind = j.get("pair")
+    if kind not in KINDS:
+        raise ValueError(f"{w}.pair: expected one of {KINDS}, got {_short(kind)}")
+    unknown = set(j) - (_PAIR_KEYS[kind] | _DH_KEYS | _LINK_KEYS | {"pair"})
+    if unknown:
+        raise ValueError(f"{w}: keys {_short(sorted(unknown))} are not valid for a {kind} pair")
+    pair = _pair(w, j, kind)
+    if "a" not in j:
+        raise ValueError(f"{w}: missing a")
+    a, offset = _number(f"{w}.a", j["a"]), _number(f"{w}.offset", j.get("offset", 0.0))
+    V.in_range(f"{w}.a", np.array(a), "m")  # AChain checks them too, but names a[i], not the key
+    V.in_range(f"{w}.offset", np.array(offset), "m")
+    return pair, a, _angle(w, j, "alpha"), offset, _angle(w, j, "theta_offset", 0.0), _link(w, j)
+
+
 def chain_from_dict(data: dict[str, Any], where: str = "chain") -> AChain:
-    """Build an AChain from the parsed TOML document."""
+    """Build an AChain from the parsed TOML document. Sizes are checked first (the number of
+    joints, every list's shape), before any work on the contents, and the joints' ranges last
+    (they need the pairs' collision limits, the slow part)."""
     unknown = set(data) - {"name", "joint", "description", "gravity"}
     if unknown:
-        raise ValueError(f"{where}: unknown keys {sorted(unknown)}")
+        raise ValueError(f"{where}: unknown keys {_short(sorted(unknown))}")
     joints = data.get("joint")
     if not isinstance(joints, list) or not joints:
         raise ValueError(f"{where}: needs at least one [[joint]] table")
-    pairs, a, alpha, offset, theta_offset, links, limits = [], [], [], [], [], [], []
-    for i, j in enumerate(joints):
-        w = f"{where}: joint {i + 1}"
-        if not isinstance(j, dict):
-            raise ValueError(f"{w}: expected a [[joint]] table, got {_short(j)}")
-        kind = j.get("pair")
-        if kind not in KINDS:
-            raise ValueError(f"{w}.pair: expected one of {KINDS}, got {_short(kind)}")
-        allowed = _PAIR_KEYS[kind] | _DH_KEYS | _LINK_KEYS | {"pair"}
-        unknown = set(j) - allowed
-        if unknown:
-            raise ValueError(f"{w}: keys {sorted(unknown)} are not valid for a {kind} pair")
-        if kind == "revolute":
-            pairs.append(APair.revolute())
-        else:
-            kw = {k: _number(f"{w}.{k}", j[k]) for k in _PAIR_KEYS[kind] if k in j}
-            for req in ("base_radius", "platform_radius") + (("leg_length",) if kind == "general" else ()):
-                if req not in kw:
-                    raise ValueError(f"{w}: missing {req}")
-            try:
-                pairs.append(APair(**kw))
-            except ValueError as exc:
-                raise ValueError(f"{w}.{exc}") from None
-        if "a" not in j:
-            raise ValueError(f"{w}: missing a")
-        a.append(_number(f"{w}.a", j["a"]))
-        alpha.append(_angle(w, j, "alpha"))
-        offset.append(_number(f"{w}.offset", j.get("offset", 0.0)))
-        theta_offset.append(_angle(w, j, "theta_offset", 0.0))
-        links.append(_link(w, j))
-        limits.append(_limits(w, j, pairs[-1]))
+    if len(joints) > MAX_JOINTS:
+        raise ValueError(f"{where}: pairs: a chain has 1 to {MAX_JOINTS} pairs, got {len(joints)} [[joint]] tables")
     gravity = _numbers(f"{where}: gravity", data.get("gravity", [0.0, 0.0, -9.81]), [(3,)])
+    V.in_range(f"{where}: gravity", gravity, "m/s^2")
+    names = [f"{where}: joint {i + 1}" for i in range(len(joints))]
+    pairs, a, alpha, offset, theta_offset, links = zip(*(_joint(w, j) for w, j in zip(names, joints)))
+    limits = [_limits(w, j, pair) for w, j, pair in zip(names, joints, pairs)]
     try:
         return AChain(pairs, a, alpha, offset, theta_offset, links=links, gravity=gravity, limits=limits)
     except ValueError as exc:
@@ -194,9 +229,9 @@ def load(path: str | os.PathLike[str]) -> AChain:
         raise ValueError(f"path: {p} is nested too deeply to be a chain file") from None
     except OSError as exc:
         raise ValueError(f"path: cannot read {str(p)!r}: {exc.strerror or exc}") from None
-    chain = chain_from_dict(data, where=str(p))
     name = data.get("name", p.stem)
     if not isinstance(name, str):
         raise ValueError(f"{p}: name: expected a string, got {_short(name)}")
+    chain = chain_from_dict(data, where=str(p))
     chain.name = name
     return chain

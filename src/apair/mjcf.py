@@ -5,7 +5,10 @@ Body tree, in the frames of docs/conventions.md §3:
 - `link{i}` is the body of link i. Its frame is pair i's *platform frame* (frame i−1 · Rz(θ_i) ·
   Tz(d_i)); its joints are the hinge `pair{i}_theta` (θ_i about the pair's axis) and, for an A-pair,
   the slide `pair{i}_d` (d_i along it, `ref` = d_i(0), so qpos holds d_i itself). Nothing couples
-  the two but the legs: the law d_i(θ_i) comes out of the loops, as in the real pair.
+  the two but the legs: the law d_i(θ_i) comes out of the loops, as in the real pair. The hinge's
+  range is the joint's hard limits (`chain.hard_limits()`, where the legs or plates collide or an
+  explicit limit stops it; none for a free joint), as stiff as the loops; `limits=False` leaves the
+  ranges out.
 - Pair i's six legs are bodies `pair{i}_leg{k}` in the body that carries frame i−1, each with a
   ball joint at its base point and an equality `connect` (`pair{i}_loop{k}`) at its platform point.
   A leg is a uniform slender rod (the model of §4): transverse inertia m L²/12 about its midpoint;
@@ -19,7 +22,8 @@ Body tree, in the frames of docs/conventions.md §3:
   `collisions=True`.
 
 The reference configuration (qpos0) is θ = 0 for every pair, where the loops close; keyframe 0 is
-the configuration q, legs included (`state`). MuJoCo needs mass and inertia in every moving body:
+the configuration q, legs included (`state`), refused outside the hard limits unless
+`outside_limits`. The model's name is escaped (quoteattr); control characters are refused. MuJoCo needs mass and inertia in every moving body:
 massless legs and links get MASSLESS × the model's mass scale, and a singular link inertia a floor
 of 1e-2 times that (kg m²); both change the dynamics by about MASSLESS.
 """
@@ -27,6 +31,7 @@ of 1e-2 times that (kg m²); both change the dynamics by about MASSLESS.
 from __future__ import annotations
 
 import math
+import unicodedata
 from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
 
@@ -103,6 +108,36 @@ def _check_q(chain: ChainLike, q: ArrayLike | None) -> NDArray[np.float64]:
     return q
 
 
+def _check_within_limits(chain: ChainLike, q: NDArray[np.float64]) -> None:
+    """Refuse a keyframe q beyond a joint's hard limits (`chain.hard_limits`, §6), where the real
+    mechanism's legs or plates collide or an explicit limit stops it; a free joint takes any angle."""
+    for i, (lo, hi) in enumerate(chain.hard_limits()):
+        if not lo <= q[i] <= hi:
+            raise ValueError(
+                f"q: joint {i + 1} at {q[i]:.10g} rad is outside its limits ({lo:.10g}, {hi:.10g}) rad "
+                "(pass outside_limits=True to export it anyway)"
+            )
+
+
+def _xml_safe(ch: str) -> bool:
+    """Whether XML 1.0 text may hold the character, control characters (C0 including tab and
+    newlines, DEL, C1) left out: they have no place in a name."""
+    return unicodedata.category(ch) not in ("Cc", "Cs") and ch not in "\ufffe\uffff"
+
+
+def _check_name(name: object) -> str:
+    """The model's name, refused if it holds a character that XML cannot (or should not) carry."""
+    if not isinstance(name, str):
+        raise ValueError(f"name: expected a string, got {V.shorten(repr(name))}")
+    for k, ch in enumerate(name):
+        if not _xml_safe(ch):
+            raise ValueError(
+                f"name: holds the control or non-XML character U+{ord(ch):04X} at position {k}; "
+                "use printable characters"
+            )
+    return name
+
+
 def state(
     chain: ChainLike, q: ArrayLike | None, qd: ArrayLike | None = None
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -153,10 +188,34 @@ def _size(chain: ChainLike, i: int) -> float:
     return max(0.02, 0.1 * max(np.abs(chain.a).max(), np.abs(chain.offset).max(), 0.1))
 
 
-def to_mjcf(chain: ChainLike, q: ArrayLike | None = None, name: str = "apair chain", collisions: bool = False) -> str:
+def _hinge(chain: ChainLike, i: int, limits: bool) -> str:
+    """Pair i's hinge; with `limits`, its range is the joint's hard limits (repr digits: the same
+    floats), as stiff as the loops (a collision stops the real joint dead); none for a joint that
+    turns freely."""
+    head = f'<joint name="pair{i + 1}_theta" type="hinge" axis="0 0 1"'
+    lo, hi = chain.hard_limits()[i]
+    if not (limits and math.isfinite(lo) and math.isfinite(hi)):
+        return head + "/>"
+    return f'{head} limited="true" range="{_f([lo, hi])}" solreflimit="{_f(SOLREF)}" solimplimit="{_f(SOLIMP)}"/>'
+
+
+def to_mjcf(
+    chain: ChainLike,
+    q: ArrayLike | None = None,
+    name: str = "apair chain",
+    collisions: bool = False,
+    limits: bool = True,
+    outside_limits: bool = False,
+) -> str:
     """The MJCF text of the chain's mechanism (see the module's docstring); keyframe 0 is q
-    (default: all zero), legs and loops consistent."""
+    (default: all zero), legs and loops consistent. `limits`: the hinges' ranges are the chain's
+    hard limits (False: no hinge range). q outside the hard limits, where the legs would collide,
+    is refused unless `outside_limits`. `name` (the model's) may not hold control characters."""
+    name = _check_name(name)
+    limits, outside_limits = V.flag("limits", limits), V.flag("outside_limits", outside_limits)
     q = _check_q(chain, q)
+    if not outside_limits:
+        _check_within_limits(chain, q)
     scale = _mass_scale(chain)
     tiny = MASSLESS * scale
     col = 'contype="1" conaffinity="1"' if collisions else 'contype="0" conaffinity="0"'
@@ -248,7 +307,7 @@ def to_mjcf(chain: ChainLike, q: ArrayLike | None = None, name: str = "apair cha
         p_body = p_prev + R_prev @ np.array([0, 0, h0])
         out.append(f'{indent}<body name="link{n1}" pos="{_f(p_body)}" quat="{_f(quat_prev)}">')
         ind = indent + "  "
-        out.append(f'{ind}<joint name="pair{n1}_theta" type="hinge" axis="0 0 1"/>')
+        out.append(ind + _hinge(chain, i, limits))
         if pair.kind != "revolute":
             top = float(max(np.max(pair.translation(np.linspace(*pair.motion_range(), 721))), h0))
             out.append(

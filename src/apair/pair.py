@@ -7,6 +7,9 @@ of derivations/apair_pair.py; this module only validates and dispatches.
 from __future__ import annotations
 
 import math
+import struct
+from collections.abc import Callable
+from functools import cached_property
 from typing import TYPE_CHECKING, cast, overload
 
 import numpy as np
@@ -39,6 +42,21 @@ def _length(name: str, value: ArrayLike, positive: bool = False) -> float:
     return x
 
 
+def _last_true(pred: Callable[[float], bool], lo: float, hi: float) -> float:
+    """The double x in [lo, hi) with pred(x) true and pred(next double above x) false, given
+    pred(lo) true, pred(hi) false and 0 <= lo < hi: bisection over the doubles' bit patterns (for
+    x >= 0 they are ordered as the values), so at most 64 steps. For a pred that is true then false
+    along the doubles (monotone), x is the largest double at which pred holds."""
+    i, j = (struct.unpack("<q", struct.pack("<d", x))[0] for x in (lo, hi))
+    while j - i > 1:
+        m = (i + j) // 2
+        if pred(struct.unpack("<d", struct.pack("<q", m))[0]):
+            i = m
+        else:
+            j = m
+    return float(struct.unpack("<d", struct.pack("<q", i))[0])
+
+
 class APair:
     """An A-pair with base/platform circumradii r_b, r_p and leg length L1 (None: sinusoidal).
 
@@ -69,7 +87,7 @@ class APair:
         else:
             L1 = _length("leg_length", leg_length, positive=True)
             L2_sq, a, b, a_plus_b = call("design_general", radii, [L1])[0]
-            if not a_plus_b > 0 or not L2_sq > 0:
+            if not a_plus_b > 0 or not a + b > 0 or not L2_sq > 0:  # a + b: d(0)² as the law forms it
                 lo = math.sqrt(r_b**2 + r_p**2 / 4 - r_b * r_p) if r_b**2 + r_p**2 / 4 > r_b * r_p else 0.0
                 raise ValueError(
                     f"leg_length: L1 = {L1} admits no real pose of this pair (need a + b > 0, i.e. "
@@ -118,18 +136,15 @@ class APair:
             return np.zeros(0)
         return np.repeat(np.array(self._L), 3)
 
-    @property
+    @cached_property
     def theta_limit(self) -> float | None:
-        """|θ| ≤ arccos(−a/b) for a general pair with a < b (the largest double at which
-        a + b cos θ ≥ 0 still holds in floating point as the law kernel forms it, so
-        d(theta_limit) ≈ 0 is defined, within √(b ε) of zero); None where θ is unbounded."""
+        """|θ| ≤ arccos(−a/b) for a general pair with a < b: the largest double at which
+        a + b cos θ ≥ 0 still holds in floating point as the law kernel forms it (so d(theta_limit)
+        ≈ 0 is defined, within √(b ε) of zero); None where θ is unbounded. Found by bisection over
+        the doubles in [0, π] (at most 64 steps for any design) and cached: near the minimum leg
+        length arccos(−a/b) is off by up to 1e11 doubles, too many to step through."""
         if self.kind == "general" and self.a < self.b:
-            lim = math.acos(-self.a / self.b)
-            while self._gap(lim) < 0:
-                lim = math.nextafter(lim, 0.0)
-            while self._gap(math.nextafter(lim, math.pi)) >= 0 and lim < math.pi:
-                lim = math.nextafter(lim, math.pi)
-            return lim
+            return _last_true(lambda th: self._gap(th) >= 0, 0.0, math.pi)
         return None
 
     def _gap(self, theta: float) -> float:

@@ -6,20 +6,29 @@
 2. Later rounds put half of their samples near the samples that landed in boundary voxels (an
    occupied voxel with an empty face neighbour): a Gaussian step in joint space, reflected back
    into the limits. The boundary, where the sample density is lowest, is where coverage is refined.
-3. The volume: voxels of size h hit by a sample overcount the body by about half a voxel over its
-   surface, so each exposed voxel face takes half a voxel off: V(h) = h³(occupied − ½ faces). What
-   remains is of order h (curvature, coverage), so V(h) is measured at five voxel sizes from h₀ to
-   2h₀, each with three random grid offsets, and extrapolated linearly to h = 0. The standard
-   uncertainty adds, in quadrature, the fit's standard error, half the extrapolation's length, the
-   change when every voxel is 1.5 times larger (resolution: edges and thin parts that a linear
-   extrapolation misses), and the coverage still missing.
-4. Coverage: the occupancy after each round grows like V∞ − A·N^(−γ) as sampled regions fill
-   in; fitted to the last three rounds, the remainder A·N^(−γ) is added to the volume and counted,
-   whole, as uncertainty. Where the rounds do not follow that law, twice the change from half the
-   samples to all of them is the uncertainty instead.
+3. Every voxel computation runs on the points normalised to unit size (the bounding box's longest
+   side is 1); lengths, areas and volumes are scaled back at the end, so a chain scaled by s has s³
+   times the volume (and the uncertainty) wherever s³ is a normal double.
+4. The volume: voxels of size h hit by a sample overcount the body by about half a voxel over its
+   surface, so each exposed voxel face takes half a voxel off: V(h) = h³(occupied − ½ faces). That
+   holds only for a voxel body the samples fill: a voxel with no sample inside the body leaves a hole
+   whose six faces cost it four voxels, and too few samples for the voxels made V(h) negative. So
+   the volume is measured at the finest voxel size from 1/resolution upwards (steps of 1.25) at
+   which there are FILL samples per occupied voxel. What remains is of order h (curvature,
+   coverage), so V(h) is measured at five voxel sizes from h to 2h, each with three random grid
+   offsets, and extrapolated linearly to size 0. The standard uncertainty adds, in quadrature, the
+   fit's standard error, half the extrapolation's length, the change when every voxel is 1.5 times
+   larger (resolution: edges and thin parts that a linear extrapolation misses), and the coverage
+   still missing. An estimate below 0 (a body thinner than its voxels) is replaced by what is known
+   for certain: the volume lies between 0 and the occupied voxels' volume, reported as that
+   interval's middle and standard deviation (uniform).
+5. Coverage: the measured volume after each round grows like V∞ − A·N^(−γ) as sampled regions fill
+   in; fitted to the last three rounds, the remainder A·N^(−γ) is added to the volume. Its
+   uncertainty is the larger of that remainder and three times the change from half the samples to all of
+   them.
 
 The cost is linear in the sample count: the fk kernel (about 1 µs per sample) and one np.unique
-per voxel size and offset (45 of them).
+per voxel size and offset (some 60 of them).
 """
 
 from __future__ import annotations
@@ -43,10 +52,17 @@ if TYPE_CHECKING:
 LEVELS = (1.0, 1.25, 1.5, 1.75, 2.0)  # voxel sizes in units of h₀
 OFFSETS = 3  # random grid offsets per voxel size
 BATCH = 50_000
-COVERAGE_FACTOR = 2.0  # the remaining coverage deficit, in units of the last doubling's change
+COVERAGE_FACTOR = 3.0  # the remaining coverage deficit, in units of the last doubling's change (γ ≈ 0.4)
 COARSER = 1.5  # the same estimate with voxels this much larger measures the resolution's effect
 MAX_GRID_BYTES = 2 * 2**30  # a voxel grid larger than this is refused, not attempted
 MAX_SAMPLE_BYTES = 8 * 2**30  # the kept samples (points, joint values, poses)
+MAX_SAMPLES = 10**8  # samples a call may ask for (about 10 minutes of fk and voxel counting)
+MAX_ROUNDS = 100
+MIN_RESOLUTION = 4  # voxels along the longest side: the coarsest grid a volume is measured on
+FILL = 12  # samples per occupied voxel at which the voxel body counts as filled
+LADDER = 1.25  # the step between the voxel sizes tried for that
+SIDE_RANGE = (1e-102, 1e102)  # the workspace's size [m] for which its cube is a normal double
+GAMMA_RANGE = (0.2, 5.0)  # coverage exponents γ taken as a power law; slower growth is not extrapolated
 LOCAL_ENGINES = ("threads", "processes", "synchronous")
 CONNECT_TIMEOUT = "10s"  # to reach a scheduler address
 
@@ -73,7 +89,9 @@ class Workspace:
     size `voxel`; volume, volume_error: the extrapolated volume [m³] and one standard uncertainty;
     dimension: that of the set of reachable points (3, or 1 and 2 for a curve or a surface, whose
     volume is None and whose length [m] or area [m²] estimate is `measure`);
-    history: (samples, corrected occupancy volume at h₀) after each round, the convergence record.
+    volume_voxel: the voxel size [m] the volume was measured at (coarser than `voxel` when the
+    samples are too few to fill finer voxels); history: (samples, corrected occupancy volume [m³]
+    at volume_voxel) after each round, the convergence record.
     """
 
     points: NDArray[np.float64]
@@ -87,6 +105,7 @@ class Workspace:
     chain_name: str = ""
     dimension: int = 3
     measure: float | None = None
+    volume_voxel: float | None = None
 
     @property
     def summary(self) -> str:
@@ -227,22 +246,101 @@ def _boundary(points: NDArray[np.float64], origin: NDArray[np.float64], h: float
 def _estimate(
     points: NDArray[np.float64], origin: NDArray[np.float64], h0: float, rng: np.random.Generator
 ) -> tuple[float, float]:
-    """Intercept and standard error of V(h) = V + c₁h over LEVELS × OFFSETS."""
-    sizes, volumes = [], []
+    """Intercept and standard error of V(h) = V + c₁h over LEVELS × OFFSETS (sizes in units of h₀,
+    so the fit's conditioning does not depend on the chain's size)."""
+    levels, volumes = [], []
     for level in LEVELS:
-        h = h0 * level
         for _ in range(OFFSETS):
-            sizes.append(h)
-            volumes.append(_corrected_volume(points, origin - rng.uniform(0, h, 3), h))
-    hs, vs = np.array(sizes), np.array(volumes)
-    A = np.stack([np.ones_like(hs), hs], axis=1)
+            levels.append(level)
+            volumes.append(_corrected_volume(points, origin - rng.uniform(0, h0 * level, 3), h0 * level))
+    x, vs = np.array(levels), np.array(volumes)
+    A = np.stack([np.ones_like(x), x], axis=1)
     coef, *_ = np.linalg.lstsq(A, vs, rcond=None)
     resid = vs - A @ coef
-    dof = len(vs) - 2
-    cov = np.linalg.inv(A.T @ A) * (resid @ resid / dof)
-    # the extrapolation itself is a model: half its length counts as uncertainty
-    model = 0.5 * abs(coef[1] * h0)
-    return float(coef[0]), float(math.sqrt(cov[0, 0] + model**2))
+    cov = np.linalg.inv(A.T @ A) * (resid @ resid / (len(vs) - 2))
+    # the extrapolation itself is a model: half its length (from level 1 to 0) counts as uncertainty
+    model = 0.5 * abs(coef[1])
+    return float(coef[0]), float(math.hypot(math.sqrt(cov[0, 0]), model))
+
+
+def _occupied(points: NDArray[np.float64], h: float) -> int:
+    """How many voxels of size h (grid at −h/2) the points hit."""
+    return len(_voxels(points, np.full(3, -0.5 * h), h))
+
+
+def _working_size(unit: NDArray[np.float64], resolution: int) -> float:
+    """The finest voxel size from 1/resolution upwards (steps of LADDER, at most 1/MIN_RESOLUTION)
+    with FILL samples per occupied voxel: coarser than that, holes of unsampled voxels inside the
+    body would each take four voxels off V(h) (module docstring, 4)."""
+    r = float(resolution)
+    while r / LADDER >= MIN_RESOLUTION and len(unit) < FILL * _occupied(unit, 1.0 / r):
+        r /= LADDER
+    return 1.0 / r
+
+
+def _unit_volume(
+    unit: NDArray[np.float64], counts: Sequence[int], resolution: int, seed: int
+) -> tuple[float, float, float, list[tuple[int, float]]]:
+    """The volume of the points normalised to unit size (module docstring, 4 and 5): volume, its
+    standard uncertainty, the voxel size it was measured at and the per-round record (samples after
+    each round in `counts`, V(h) then)."""
+    h = _working_size(unit, resolution)
+    origin = np.full(3, -0.5 * h)
+    history = [(n, _corrected_volume(unit[:n], origin, h)) for n in counts]
+
+    def rng() -> np.random.Generator:
+        return np.random.default_rng((seed, 99))
+
+    volume, fit_err = _estimate(unit, origin, h, rng())
+    coarse, _ = _estimate(unit, origin, COARSER * h, rng())
+    half, _ = _estimate(unit[: len(unit) // 2], origin, h, rng())
+    remainder = _coverage_remainder(history) or 0.0
+    coverage = max(remainder, COVERAGE_FACTOR * abs(volume - half))
+    error = math.sqrt(fit_err**2 + coverage**2 + (volume - coarse) ** 2)
+    volume += remainder
+    if volume < 0:  # a body thinner than its voxels: only 0 ≤ V ≤ the occupied volume is known
+        top = _occupied(unit, h) * h**3
+        volume, error = 0.5 * top, top / math.sqrt(12)
+    return volume, error, h, history
+
+
+def _check_counts(
+    chain: ChainLike, samples: object, resolution: object, rounds: object, poses: bool
+) -> tuple[int, int, int]:
+    """samples, resolution and rounds as integers within the work and memory they may ask for."""
+    from . import _validate as V
+
+    samples = V.integer("samples", samples, maximum=MAX_SAMPLES)
+    top = int(MAX_GRID_BYTES ** (1 / 3)) - 4  # (resolution + 4)³ bytes: the finest voxel grid with margins
+    resolution = V.integer("resolution", resolution, minimum=MIN_RESOLUTION, maximum=top)
+    rounds = V.integer("rounds", rounds, maximum=MAX_ROUNDS)
+    per_sample = (3 + len(chain.pairs)) * 8 + (8 * 8 if poses else 0)  # points, joint values, poses
+    if samples * per_sample > MAX_SAMPLE_BYTES:
+        raise ValueError(
+            f"samples: {samples} samples need more than {MAX_SAMPLE_BYTES / 2**30:.0f} GiB to keep; "
+            f"at most {MAX_SAMPLE_BYTES // per_sample} fit"
+        )
+    if samples < 1000 * rounds:
+        raise ValueError(f"samples: at least {1000 * rounds} are needed for {rounds} rounds, got {samples}")
+    return samples, resolution, rounds
+
+
+def _unit_box(pts: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+    """The lower corner and longest side [m] of the first round's points, refused when the
+    points are not finite or the volume of a box that size is not a normal double."""
+    if not np.isfinite(pts).all():
+        raise ValueError("chain: the forward kinematics gives non-finite end-effector positions")
+    box_lo = pts.min(axis=0)
+    side = float(np.max(pts.max(axis=0) - box_lo))
+    if side <= 0:
+        raise ValueError("chain: every sample reaches the same point; the workspace has no volume")
+    lo, hi = SIDE_RANGE
+    if not lo <= side <= hi:
+        raise ValueError(
+            f"chain: the workspace is {side:.3g} m across; its volume is computed for sizes from {lo:g} "
+            f"to {hi:g} m (where volumes are normal doubles)"
+        )
+    return box_lo, side
 
 
 def workspace(
@@ -257,101 +355,68 @@ def workspace(
 ) -> Workspace:
     """Approximate the reachable workspace of the end-effector origin (see the module docstring).
 
-    samples: total joint samples; resolution: voxels along the longest side of the bounding box
-    (h₀ = side / resolution); rounds: sampling rounds (the first uniform); poses: keep the Study
-    points too; engine: None (this process), "threads" or "processes" (local Dask), a
-    dask.distributed scheduler address or Client; progress: callable(done, total) or None.
+    samples: total joint samples (1000 per round to MAX_SAMPLES); resolution: voxels along the
+    longest side of the bounding box for the boundary (h₀ = side / resolution), the finest the
+    volume is measured at; rounds: sampling rounds (the first uniform, at most MAX_ROUNDS); poses:
+    keep the Study points too; engine: None (this process), "threads" or "processes" (local Dask),
+    a dask.distributed scheduler address or Client; progress: callable(done, total) or None.
     """
     from . import _validate as V
 
-    samples = V.integer("samples", samples)
-    resolution = V.integer("resolution", resolution)
-    rounds = V.integer("rounds", rounds)
+    samples, resolution, rounds = _check_counts(chain, samples, resolution, rounds, V.flag("poses", poses))
+    seed = V.seed(seed)
     _check_engine(engine)
-    grid = (resolution + 4) ** 3  # bytes of the finest voxel grid (booleans, one voxel of margin a side)
-    if grid > MAX_GRID_BYTES:
-        top = int(MAX_GRID_BYTES ** (1 / 3)) - 4
-        raise ValueError(
-            f"resolution: {resolution} voxels along the longest side need voxel grids of about "
-            f"{grid / 2**30:.1f} GiB; at most {top} fit in {MAX_GRID_BYTES / 2**30:.0f} GiB"
-        )
-    if samples * (3 + len(chain.pairs)) * 8 * (2 if poses else 1) > MAX_SAMPLE_BYTES:
-        raise ValueError(f"samples: {samples} samples need more than {MAX_SAMPLE_BYTES / 2**30:.0f} GiB to keep")
-    if samples < 1000 * rounds:
-        raise ValueError(f"samples: at least {1000 * rounds} are needed for {rounds} rounds, got {samples}")
-    if resolution < 4:
-        raise ValueError(f"resolution: at least 4 voxels along the longest side, got {resolution}")
     lim = chain.limits
     lo, hi = lim[:, 0], lim[:, 1]
     per_round = samples // rounds
     sigma = 0.05 * (hi - lo)
     parts: list[dict[str, NDArray[np.float64]]] = []
-    history: list[tuple[int, float]] = []
+    counts: list[int] = []  # samples after each round
     # the round's centres of its Gaussian samples and their spread (none in the first round)
     centres: NDArray[np.float64] | None = None
     step: NDArray[np.float64] | None = None
+    h0 = 1.0 / resolution  # in units of the bounding box's longest side, as every voxel below
+    origin = np.full(3, -0.5 * h0)
     done, total = 0, rounds * math.ceil(per_round / BATCH)
     for r in range(rounds):
-        counts = [min(BATCH, per_round - k) for k in range(0, per_round, BATCH)]
+        sizes = [min(BATCH, per_round - k) for k in range(0, per_round, BATCH)]
         tasks: list[_Task] = [
-            (chain, lo, hi, (seed, r, k), c, centres if k % 2 else None, step, poses) for k, c in enumerate(counts)
+            (chain, lo, hi, (seed, r, k), c, centres if k % 2 else None, step, poses) for k, c in enumerate(sizes)
         ]
         tick = (lambda k, _n, done=done: progress(done + k, total)) if progress else None
         parts += _run(tasks, engine, tick)
-        done += len(counts)
+        done += len(sizes)
         pts = np.concatenate([p["points"] for p in parts])
         qs = np.concatenate([p["q"] for p in parts])
         if r == 0:
-            box_lo, box_hi = pts.min(axis=0), pts.max(axis=0)
-            side = float(np.max(box_hi - box_lo))
-            if side <= 0:
-                raise ValueError("chain: every sample reaches the same point; the workspace has no volume")
-            h0 = side / resolution
-            origin = box_lo - 0.5 * h0
-        history.append((len(pts), _corrected_volume(pts, origin, h0)))
+            box_lo, side = _unit_box(pts)
+        unit = (pts - box_lo) / side
+        counts.append(len(pts))
         if r + 1 < rounds:  # the next round: half of its samples near those in boundary voxels
-            edge = _boundary(pts, origin, h0)
-            key = np.floor((pts - origin) / h0).astype(np.int64)
-            on_edge = _member(key, edge)
+            edge = _boundary(unit, origin, h0)
+            on_edge = _member(np.floor((unit - origin) / h0).astype(np.int64), edge)
             centres = qs[on_edge] if on_edge.any() else qs
             step = sigma / (1 + (r + 1))
     dimension = _dimension(chain, qs, side)
-    edge = _boundary(pts, origin, h0)
-    if dimension < 3:
-        return Workspace(
-            points=pts,
-            q=qs,
-            boundary=origin + (edge + 0.5) * h0,
-            voxel=h0,
-            volume=None,
-            volume_error=None,
-            poses=np.concatenate([p["poses"] for p in parts]) if poses else None,
-            history=history,
-            chain_name=getattr(chain, "name", ""),
-            dimension=dimension,
-            measure=_measure(chain, pts, qs, origin, h0, dimension),
-        )
-    rng = np.random.default_rng((seed, 99))
-    volume, fit_err = _estimate(pts, origin, h0, rng)
-    coarse, _ = _estimate(pts, origin, COARSER * h0, np.random.default_rng((seed, 99)))
-    missing = _coverage_remainder(history)
-    if missing is None:  # no clean power law in the rounds: the half-sample change, doubled
-        half, _ = _estimate(pts[: len(pts) // 2], origin, h0, np.random.default_rng((seed, 99)))
-        missing = COVERAGE_FACTOR * abs(volume - half)
-    else:
-        volume += missing
-    error = math.sqrt(fit_err**2 + missing**2 + (volume - missing - coarse) ** 2)
-    return Workspace(
+    ws = Workspace(
         points=pts,
         q=qs,
-        boundary=origin + (edge + 0.5) * h0,
-        voxel=h0,
-        volume=volume,
-        volume_error=error,
+        boundary=box_lo + side * (origin + (_boundary(unit, origin, h0) + 0.5) * h0),
+        voxel=side * h0,
+        volume=None,
+        volume_error=None,
         poses=np.concatenate([p["poses"] for p in parts]) if poses else None,
-        history=history,
         chain_name=getattr(chain, "name", ""),
+        dimension=dimension,
     )
+    if dimension < 3:
+        ws.measure = _measure(chain, unit, qs, origin, h0, dimension) * side**dimension
+        return ws
+    volume, error, h, history = _unit_volume(unit, counts, resolution, seed)
+    scale = side**3  # a normal double: side is within SIDE_RANGE
+    ws.volume, ws.volume_error, ws.volume_voxel = volume * scale, error * scale, h * side
+    ws.history = [(n, v * scale) for n, v in history]
+    return ws
 
 
 def _dimension(chain: ChainLike, qs: NDArray[np.float64], side: float, probes: int = 256) -> int:
@@ -369,7 +434,8 @@ def _measure(
     h: float,
     dimension: int,
 ) -> float:
-    """Length (dimension 1) or area (2) of the reachable set from the voxels its samples occupy:
+    """Length (dimension 1) or area (2) of the reachable set, in units of the points' (the caller
+    scales it back), from the voxels its samples occupy:
     a curve with unit tangent t crosses |t|₁/h voxels per unit length, a surface with unit normal n
     |n|₁/h² per unit area, so each occupied voxel contributes h/|t|₁ (h²/|n|₁) with the tangent
     (normal) of one sample in it, from the Jacobian there; measured at the voxel sizes LEVELS and
@@ -391,7 +457,8 @@ def _measure(
 def _coverage_remainder(history: Sequence[tuple[int, float]]) -> float | None:
     """The volume still to come as the sample count grows without bound, from the occupancy of the
     last three rounds: V(N) = V∞ − A·N^(−γ) fitted exactly; None when the rounds do not grow
-    like that (fewer than three rounds, no growth, or growth that does not slow down)."""
+    like that (fewer than three rounds, no growth, growth that does not slow down, or γ outside
+    GAMMA_RANGE: slower growth extrapolates to an unbounded remainder)."""
     if len(history) < 3:
         return None
     (n1, v1), (n2, v2), (n3, v3) = history[-3:]
@@ -402,7 +469,7 @@ def _coverage_remainder(history: Sequence[tuple[int, float]]) -> float | None:
     def ratio(g: float) -> float:
         return (n1**-g - n2**-g) / (n2**-g - n3**-g)
 
-    lo, hi = 1e-3, 5.0
+    lo, hi = GAMMA_RANGE
     target = d1 / d2
     if not ratio(lo) < target < ratio(hi):
         return None

@@ -243,7 +243,7 @@ def test_ik_local_converges_within_limits_batched():
         ({"T": np.eye(3)}, r"T: expected a 4x4 transform"),
         ({"q0": np.zeros(5)}, r"q0"),
         ({"q0": np.full(6, 10.0)}, r"q0: joint 1 lies outside chain.limits"),
-        ({"max_iter": 0}, r"max_iter: expected a positive integer"),
+        ({"max_iter": 0}, r"max_iter: must be >= 1"),
         ({"tol": -1.0}, r"tol"),
         ({"T": np.stack([np.eye(4)] * 3 + [np.diag([1.0, 1.0, -1.0, 1.0])])}, r"not a proper rotation"),
         (

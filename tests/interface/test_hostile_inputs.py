@@ -123,7 +123,9 @@ def test_ik_local_max_iter_is_bounded(value):
         c.ik_local(c.fk([0.1, 0.2]), [0.0, 0.0], max_iter=value)
 
 
-@pytest.mark.parametrize("value, message", [(None, "expected"), (-1, "must be >= 0"), (2**64, "must be <="), (1.5, "integer")])
+@pytest.mark.parametrize(
+    "value, message", [(None, "expected"), (-1, "must be >= 0"), (2**64, "must be <="), (1.5, "integer")]
+)
 def test_seeds_must_be_integers_in_range(value, message):
     c = load(CHAIN2)
     with pytest.raises(ValueError, match=f"^seed: .*{message}"):

@@ -46,7 +46,10 @@ degenerate, and each has its own remedy:
 
 Every real candidate is checked with the chain's own fk kernel, refined by up to two Gauss-Newton
 steps where it is not already accurate to 1e-3·tol, and kept only if fk(q) reproduces T to `tol`
-(largest entry of the 4×4 difference); duplicates are merged (apair.ik.poses.refine). Angles are
+(largest entry of the 4×4 difference, its translations in units of the chain's length scale,
+apair.ik.poses.length_scale); duplicates are merged (apair.ik.poses.refine). The elimination
+itself works on the design and the target in units of that scale, so it is the same problem at
+every scale. Angles are
 returned in (−2π, 2π] for A-pairs (their motion has period 4π) and (−π, π] for R-pairs. General
 (non-sinusoidal) A-pairs have an elliptic, not rational, motion and are not supported.
 

@@ -13,9 +13,19 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _validate as V
 from ..kernels import native_module
-from .homotopy.problem import scale_of
 from .pencil import SEED
-from .poses import check_matrix, error_weights, jacobian_rank, joint_periods, matrix_of, pose_error, study_point
+from .poses import (
+    check_matrix,
+    error_weights,
+    jacobian_rank,
+    joint_periods,
+    length_scale,
+    norm3,
+    pose_error,
+    pose_of,
+    reach_of,
+    translation_norm,
+)
 
 if TYPE_CHECKING:
     from .._typing import ChainLike
@@ -76,6 +86,9 @@ def local_search(
     return q
 
 
+FAR_SEARCH = 1e3  # a pose further than this many reaches is searched for along its direction
+
+
 def distance(
     chain: ChainLike, T: ArrayLike, starts: int = 64, seed: int = SEED
 ) -> tuple[float, float, NDArray[np.float64]]:
@@ -83,14 +96,24 @@ def distance(
     (position error [m], rotation error [rad], q) at the best of `starts` batched
     Levenberg-Marquardt fits of fk(q) to T (pose error weighted by the chain's length scale), a
     bounded amount of work (60 iterations of one batched fk and Jacobian call). An estimate for
-    reporting unreachable poses, not part of the exact solver."""
-    study_point(T)  # validates
-    Tm = matrix_of(T)
-    q = local_search(chain, Tm, seeds=starts, seed=seed, bounds=chain.limits)
-    e, _ = pose_error(chain, q, Tm)
+    reporting unreachable poses, not part of the exact solver. A pose far out (beyond FAR_SEARCH
+    reaches) is fitted at that distance in its direction, where the nearest pose is the same to
+    the last digits, and the squares of its errors stay finite."""
+    Tm = pose_of(T).matrix
+    far = FAR_SEARCH * (reach_of(chain) + length_scale(chain))
+    d = translation_norm(Tm)
+    target = Tm
+    if d > far:
+        target = Tm.copy()
+        u = Tm[:3, 3] / np.abs(Tm[:3, 3]).max()  # the direction, without overflow
+        target[:3, 3] = u * (far / norm3(u))
+    q = local_search(chain, target, seeds=starts, seed=seed, bounds=chain.limits)
+    e, _ = pose_error(chain, q, target)
     best = q[int(np.argmin(np.sum(e * e, axis=1)))]
     F = chain.fk(best)
-    dp = float(np.linalg.norm(F[:3, 3] - Tm[:3, 3]))
+    dp = norm3(F[:3, 3] - Tm[:3, 3])
+    if not np.isfinite(dp):
+        raise ValueError("T: the translation's distance from the chain overflows a double")
     c = (np.trace(F[:3, :3].T @ Tm[:3, :3]) - 1) / 2
     return dp, float(np.arccos(np.clip(c, -1.0, 1.0))), best
 
@@ -143,7 +166,7 @@ def ik_local(chain: ChainLike, T: ArrayLike, q0: ArrayLike, tol: float = 1e-10, 
         np.ascontiguousarray(chain._dh, float),
         np.ascontiguousarray(lim[:, 0]),
         np.ascontiguousarray(lim[:, 1]),
-        scale_of(chain),
+        length_scale(chain),
         Tb,
         qb,
         tol,

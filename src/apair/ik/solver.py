@@ -5,22 +5,36 @@ method by the chain's shape. 1 to 4 joints: the elimination by kinematic mapping
 (apair.ik.elimination6r), the one-A-pair elimination (apair.ik.elimination1a5r), else parameter
 homotopy from the design's start system (apair.ik.homotopy). Every real candidate is verified and
 refined by apair.ik.poses.refine.
+
+Every method works on the chain in units of its length scale L (apair.ik.poses.length_scale: the
+pose's translation divided by L, the design's lengths too), and the tolerances on translations
+are relative to L: a chain scaled by s has the same solutions at the pose with its translation
+scaled by s. A pose beyond the chain's reach bound is answered without any elimination.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import elimination1a5r, elimination6r, homotopy
 from .elimination4 import CAND_TOL, Elimination
-from .homotopy.problem import scale_of
 from .local import local_search, on_continuum
 from .pencil import SEED, Degenerate
-from .poses import jacobian_rank, matrix_of, near_reach, pose_matrix, refine, study_point, with_twins
+from .poses import (
+    Pose,
+    jacobian_rank,
+    length_scale,
+    near_reach,
+    pose_of,
+    reach_of,
+    refine,
+    translation_norm,
+    with_twins,
+)
 
 if TYPE_CHECKING:
     from .._typing import ChainLike
@@ -35,7 +49,8 @@ class Solution:
     asked for); candidates: real candidates examined; error: fk error of each solution;
     certified: False when the elimination degenerated (or found nothing) at this pose and the
     solutions come from the local fallback search, so that the set may be incomplete; method: how
-    the set was found."""
+    the set was found ("reach bound": the pose's position lies beyond Σ |a| + |c| + 2h from the
+    base, so no joint vector reaches it)."""
 
     q: NDArray[np.float64]
     error: NDArray[np.float64]
@@ -43,7 +58,38 @@ class Solution:
     complex_count: int | None = None
     certified: bool = True
     inside: NDArray[np.bool_] | None = None  # (k,) within the chain's joint limits (set by AChain.ik)
-    method: str = "elimination"  # or "homotopy" (n = 5, 6), or "local search" (the fallback)
+    method: str = "elimination"  # or "homotopy" (n = 5, 6), "local search" (the fallback), "reach bound"
+
+
+FAR = 1e6  # beyond FAR times the reach bound a pose is answered by the bound even when complex
+#           solutions are counted (the eliminations' coefficients would span 1e12 and more)
+
+
+class _Pair(NamedTuple):
+    kind: str
+    amplitude: float
+
+
+@dataclass(frozen=True)
+class _UnitDesign:
+    """The chain's design in units of its length scale, as homotopy.Problem.of reads a chain (its
+    scale comes out exactly 1, its normalised lengths bit for bit those of the chain itself
+    wherever the chain's scale is 1 mm or more, so that the cached start systems' keys agree)."""
+
+    pairs: list[_Pair]
+    a: np.ndarray
+    alpha: np.ndarray
+    offset: np.ndarray
+    theta_offset: np.ndarray
+
+    @property
+    def n(self) -> int:
+        return len(self.pairs)
+
+    @staticmethod
+    def of(chain: ChainLike, scale: float) -> _UnitDesign:
+        pairs = [_Pair(p.kind, p.amplitude / scale) for p in chain.pairs]
+        return _UnitDesign(pairs, chain.a / scale, chain.alpha, chain.offset / scale, chain.theta_offset)
 
 
 class Solver:
@@ -64,7 +110,8 @@ class Solver:
                     "needs sinusoidal A-pairs or R-pairs"
                 )
         self.chain = chain
-        self.scale = scale_of(chain)
+        self.scale = length_scale(chain)
+        self.reach = reach_of(chain)
         self.seed = seed
         self._eliminations: dict[bool, Elimination] = {}
         self._problem: Problem | None = None  # n = 5, 6: the homotopy.Problem
@@ -76,11 +123,29 @@ class Solver:
         return self._eliminations[reverse]
 
     def solve(self, T: ArrayLike, tol: float = 1e-9, count_complex: bool = False) -> Solution:
+        """All real solutions at T, verified to tol (rotation entries; translations in units of
+        the chain's length scale; a float32 pose to its own precision at least, `Pose.floor`)."""
+        pose = pose_of(T)
+        tol = max(tol, pose.floor)
+        if self._beyond_reach(pose.matrix, count_complex):
+            n = self.chain.n
+            return Solution(np.zeros((0, n)), np.zeros(0), 0, None, method="reach bound")
         if self.chain.n >= 5:
-            return self._solve_homotopy(T, tol)
-        target = study_point(T)
+            return self._solve_homotopy(pose, tol)
+        return self._solve_elimination(pose, tol, count_complex)
+
+    def _beyond_reach(self, Tm: NDArray[np.float64], count_complex: bool) -> bool:
+        """Whether the pose is answered by the reach bound alone: beyond it (where only a count of
+        the complex solutions needs an elimination) or beyond FAR times it."""
+        if near_reach(self.chain, Tm, self.reach, self.scale):
+            return False
+        return not count_complex or translation_norm(Tm) > FAR * (self.reach + self.scale)
+
+    def _solve_elimination(self, pose: Pose, tol: float, count_complex: bool) -> Solution:
+        """n ≤ 4: the elimination on the chain as given, else reversed, else the local search."""
+        target = pose.study.copy()
         target[4:] /= self.scale
-        Tm = matrix_of(T)
+        Tm = pose.matrix
         n = self.chain.n
         degenerate = []
         for reverse in (False, True) if n >= 2 else (False,):
@@ -90,16 +155,19 @@ class Solver:
                 degenerate.append(str(exc))
                 continue
             cands = np.array(found, complex).reshape(-1, n)
+            if not np.isfinite(cands).all():  # a lost candidate: its "none" would prove nothing
+                degenerate.append("a candidate is not finite")
+                continue
             # points where a joint's rotation part vanishes (u = ±i, isotropic) are not displacements
             cands = cands[np.all(np.abs(1 + cands * cands) > 1e-3 * (1 + np.abs(cands) ** 2), axis=1)]
             count = len(_dedupe_complex(cands)) if count_complex else None
             real = cands[np.all(np.abs(cands.imag) <= CAND_TOL * (1 + np.abs(cands)), axis=1)]
             q = with_twins(self.chain, self._elimination(reverse).angles(real))
-            q, err = refine(self.chain, q, Tm, tol)
-            if len(q) or not near_reach(self.chain, Tm):
+            q, err = refine(self.chain, q, Tm, tol, self.scale)
+            if len(q) or not near_reach(self.chain, Tm, self.reach, self.scale):
                 return Solution(q, err, len(real), count)
         # every elimination degenerated, or found nothing for a pose within reach: local search
-        q, err = refine(self.chain, local_search(self.chain, Tm), Tm, tol)
+        q, err = refine(self.chain, local_search(self.chain, Tm), Tm, tol, self.scale)
         if len(q) and on_continuum(self.chain, q[0], Tm, tol):
             why = f" ({degenerate[0]})" if degenerate else ""
             raise ValueError(
@@ -108,28 +176,31 @@ class Solver:
         certified = len(q) == 0 and not degenerate  # the elimination's "none" stands
         return Solution(q, err, 0, None, certified=certified, method="local search")
 
-    def _solve_homotopy(self, T: ArrayLike, tol: float) -> Solution:
+    def _solve_homotopy(self, pose: Pose, tol: float) -> Solution:
         """n = 5, 6: R-chains by the 6R elimination (apair.ik.elimination6r) where it certifies its
         16 solutions, chains with one A-pair by theirs (apair.ik.elimination1a5r, 48); otherwise
-        every start solution tracked to T (apair.ik.homotopy). Real solutions verified."""
-        Tm = pose_matrix(T)
+        every start solution tracked to T (apair.ik.homotopy). Real solutions verified. All three
+        work on the design in units of its length scale (`_UnitDesign`) and T's translation too."""
+        Tm = pose.matrix
+        Tu = Tm.copy()
+        Tu[:3, 3] /= self.scale
         if self._problem is None:
-            self._problem = homotopy.Problem.of(self.chain)
+            self._problem = homotopy.Problem.of(_UnitDesign.of(self.chain, self.scale))
         problem = self._problem
         theta = None
         for route in (elimination6r, elimination1a5r):
             if route.applies(problem):
-                theta = route.solve(problem, Tm)
+                theta = route.solve(problem, Tu)
         if theta is not None:
             theta, complete, method = homotopy.own(problem, theta), True, "elimination"
         else:
             if self._start is None:
                 self._start = homotopy.start_system(problem)
-            ends = homotopy.solve(problem, self._start, Tm)
+            ends = homotopy.solve(problem, self._start, Tu)
             theta, complete, method = ends.theta, ends.complete, "homotopy"
             self._refuse_continuum(problem, ends, Tm, tol)
         real = homotopy.real_angles(problem, theta)
-        q, err = refine(self.chain, real, Tm, tol)
+        q, err = refine(self.chain, real, Tm, tol, self.scale)
         return Solution(q, err, len(real), len(theta), certified=complete, method=method)
 
     def _refuse_continuum(self, problem: Problem, ends: Endpoints, Tm: NDArray[np.float64], tol: float) -> None:
@@ -141,8 +212,8 @@ class Solver:
         if len(singular) == 0:
             return
         q = homotopy.real_angles(problem, singular.real.astype(complex))
-        q, _ = refine(self.chain, local_search(self.chain, Tm, start=q), Tm, tol)
-        for k in np.flatnonzero(jacobian_rank(self.chain, q) < self.chain.n):
+        q, _ = refine(self.chain, local_search(self.chain, Tm, start=q), Tm, tol, self.scale)
+        for k in np.flatnonzero(jacobian_rank(self.chain, q, self.scale) < self.chain.n):
             if on_continuum(self.chain, q[k], Tm, tol):
                 raise ValueError(
                     "T: the solutions at this pose are not isolated: they form a curve (e.g. a wrist "

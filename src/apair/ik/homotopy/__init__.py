@@ -38,8 +38,11 @@ reaches all of it:
   when two independent monodromy runs (each from its own random start, each stable for STABLE
   loops) found the same number, the union's, and CHECK_LOOPS further loops carry every solution
   without losing a path. That is weaker: a solution that every run misses (far out in the complex,
-  where paths lose digits) goes unnoticed. A pose's answer is complete when, in addition, every
-  path ended (finite, or diverging to infinity) at a distinct point.
+  where paths lose digits) goes unnoticed. A pose's answer is complete when, in addition, its
+  distinct finite endpoints plus its confirmed paths to infinity make up the start count. A path
+  reported as diverging proves nothing by itself (at a generic pose every solution is finite, and
+  a path can jump off to infinity): its start is tracked again with new γ, and paths to infinity
+  count only when `endpoints.CONFIRM` rounds without failures agree on them (see `solve`).
 """
 
 from __future__ import annotations
