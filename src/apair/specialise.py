@@ -100,10 +100,11 @@ def prefix_from(path: str | os.PathLike[str]) -> str:
     stem = re.sub(r"[^A-Za-z0-9_]", "_", Path(path).stem) or "chain"
     if stem[0].isdigit():
         stem = "chain_" + stem
-    stem = stem[:42]
-    if stem.lower() in _TAKEN_NAMES or stem in _C_KEYWORDS or keyword.iskeyword(stem) or stem.startswith("apair"):
-        stem = "chain_" + stem  # math.toml gives chain_math, not a math.h beside the user's code
-    return check_prefix(stem)
+    stem = stem[:42]  # an identifier by now: check_prefix can refuse it only as a reserved name
+    try:
+        return check_prefix(stem)
+    except ValueError:
+        return check_prefix("chain_" + stem)  # math.toml gives chain_math, not a math.h beside the user's code
 
 
 def check_kernels(kernels: Iterable[str] | None) -> tuple[str, ...]:
