@@ -2,7 +2,8 @@
 
 Pictures, models and pages go where the caller says, by one set of rules (`target`, `write`,
 `write_text`): a suffix is added where the name has none, a folder is refused, and an existing
-file is replaced only with overwrite=True (never written through a symlink). What apair computes
+file is replaced only with overwrite=True (never written through a symlink; the refusal is a
+`Refusal`, which a command line words with its own option). What apair computes
 once and keeps (compiled specialised chains, inverse-kinematics start systems) goes into the cache
 (`cache_root`), keyed by content hashes that include the toolkit that made it (`toolkit_digest`).
 """
@@ -20,6 +21,24 @@ from pathlib import Path
 
 from ._validate import flag, shorten
 from ._version import __version__
+
+
+class Refusal(ValueError):
+    """A refusal that an argument of the call lifts (overwrite=True replaces an existing file): the
+    message tells the caller of the API to pass it; a command line names its own option instead
+    (`told`), so that neither speaks the other's language."""
+
+    def __init__(self, reason: str, argument: str, effect: str) -> None:
+        self.reason, self.argument, self.effect = reason, argument, effect
+        super().__init__(f"{reason}; pass {argument}=True {effect}")
+
+    def told(self, option: str) -> str:
+        """The message for a command line whose `option` lifts the refusal."""
+        return f"{self.reason}; use {option} {self.effect}"
+
+    def __reduce__(self) -> tuple[type[Refusal], tuple[str, str, str]]:
+        return type(self), (self.reason, self.argument, self.effect)  # picklable (its own arguments)
+
 
 _KINDS = {".png": "a PNG picture", ".gif": "a GIF animation", ".xml": "an XML model", ".html": "an HTML page"}
 
@@ -50,7 +69,7 @@ def target(path: str | os.PathLike[str], overwrite: bool, suffix: str = ".png") 
     if p.exists() and not p.is_file() and not p.is_symlink():
         raise ValueError(f"path: {str(p)!r} is not a regular file")
     if (p.exists() or p.is_symlink()) and not overwrite:
-        raise ValueError(f"path: {str(p)!r} exists; pass overwrite=True (or --force) to replace it")
+        raise Refusal(f"path: {str(p)!r} exists", "overwrite", "to replace it")
     if not p.parent.is_dir():
         raise ValueError(f"path: folder {str(p.parent)!r} does not exist")
     return p

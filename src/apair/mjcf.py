@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from . import _validate as V
+from .files import Refusal
 from .kernels import call
 
 if TYPE_CHECKING:
@@ -113,9 +114,10 @@ def _check_within_limits(chain: ChainLike, q: NDArray[np.float64]) -> None:
     mechanism's legs or plates collide or an explicit limit stops it; a free joint takes any angle."""
     for i, (lo, hi) in enumerate(chain.hard_limits()):
         if not lo <= q[i] <= hi:
-            raise ValueError(
-                f"q: joint {i + 1} at {q[i]:.10g} rad is outside its limits ({lo:.10g}, {hi:.10g}) rad "
-                "(pass outside_limits=True to export it anyway)"
+            raise Refusal(
+                f"q: joint {i + 1} at {q[i]:.10g} rad is outside its limits ({lo:.10g}, {hi:.10g}) rad",
+                "outside_limits",
+                "to export it anyway",
             )
 
 
@@ -156,7 +158,7 @@ def state(
         d, dd = pair.law(q[i])[:2]
         if not (d > FLAT * max(pair.base_radius, pair.platform_radius) and np.isfinite(dd)):
             raise ValueError(
-                f"q: pair {i + 1} is at d = 0 (legs flat, q[{i}] = {q[i]!r}), where the loops leave "
+                f"q: pair {i + 1} is at d = 0 (legs flat, q = {float(q[i]):.12g} rad), where the loops leave "
                 "the legs' positions and rates undetermined"
             )
         base, length, frames = _reference_legs(pair)

@@ -438,8 +438,12 @@ def _measure(
     scales it back), from the voxels its samples occupy:
     a curve with unit tangent t crosses |t|₁/h voxels per unit length, a surface with unit normal n
     |n|₁/h² per unit area, so each occupied voxel contributes h/|t|₁ (h²/|n|₁) with the tangent
-    (normal) of one sample in it, from the Jacobian there; measured at the voxel sizes LEVELS and
-    extrapolated linearly to size 0."""
+    (normal) of one sample in it, from the Jacobian there; measured at the voxel sizes LEVELS,
+    from the finest from h up at which the samples fill the voxels (FILL per occupied voxel, as
+    for volumes: finer, unsampled gaps would count as missing length or area), and extrapolated
+    linearly to size 0. The extrapolation removes the rim's excess, a fraction of the finest
+    size's value; where it would remove more than half (voxels too coarse for a line fit, the
+    estimate could even turn negative), the finest size's value is kept."""
 
     def at(size: float) -> float:
         idx = np.floor((pts - origin) / size).astype(np.int64)
@@ -449,9 +453,12 @@ def _measure(
         return float(np.sum(size**dimension / np.abs(direction).sum(axis=1)))
 
     # voxels at the rim (the ends) are partly outside: an excess of order h, extrapolated away
+    while h * LADDER <= 1.0 / MIN_RESOLUTION and len(pts) < FILL * _occupied(pts, h):
+        h *= LADDER
     sizes = h * np.array(LEVELS)
     values = [at(size) for size in sizes]
-    return float(np.polyfit(sizes, values, 1)[1])
+    zero = float(np.polyfit(sizes, values, 1)[1])
+    return zero if 0.5 * values[0] <= zero <= values[0] else values[0]
 
 
 def _coverage_remainder(history: Sequence[tuple[int, float]]) -> float | None:

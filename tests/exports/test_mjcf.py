@@ -209,7 +209,7 @@ def test_options_and_files(tmp_path):
 
 def test_cli_export(tmp_path, capsys):
     out = tmp_path / "chain.xml"
-    assert main(["export", "mjcf", EXAMPLE, str(out), "--q", "10,20,-30,40", "--deg"]) == 0
+    assert main(["export", "mjcf", EXAMPLE, "--out", str(out), "--q", "10,20,-30,40", "--deg"]) == 0
     assert "MuJoCo model written" in capsys.readouterr().out
     m = mujoco.MjModel.from_xml_path(str(out))
     d = mujoco.MjData(m)
@@ -219,11 +219,11 @@ def test_cli_export(tmp_path, capsys):
         d.qpos[[m.jnt_qposadr[j] for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]],
         np.radians([10, 20, -30, 40]),
     )
-    assert main(["export", "mjcf", EXAMPLE, str(out)]) == 2  # exists
+    assert main(["export", "mjcf", EXAMPLE, "--out", str(out)]) == 2  # exists
     assert "exists" in capsys.readouterr().err
-    assert main(["export", "mjcf", EXAMPLE, str(tmp_path / "b.xml"), "--q", "1,x,2,3"]) == 2
+    assert main(["export", "mjcf", EXAMPLE, "--out", str(tmp_path / "b.xml"), "--q", "1,x,2,3"]) == 2
     assert "not a number" in capsys.readouterr().err
-    assert main(["export", "mjcf", EXAMPLE, str(out), "--force"]) == 0
+    assert main(["export", "mjcf", EXAMPLE, "--out", str(out), "--force"]) == 0
     assert out.read_text() == chain.to_mjcf()
 
 

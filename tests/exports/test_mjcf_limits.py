@@ -161,7 +161,7 @@ def test_default_keyframe_outside_explicit_limits_is_refused():
 def test_cli_keyframe_outside_the_limits(tmp_path, capsys):
     """apair export mjcf --q past a collision limit: a one-line error, exit 2, no file."""
     out = tmp_path / "m.xml"
-    assert main(["export", "mjcf", "examples/2a_chain.toml", str(out), "--q", "130,0", "--deg"]) == 2
+    assert main(["export", "mjcf", "examples/2a_chain.toml", "--out", str(out), "--q", "130,0", "--deg"]) == 2
     err = capsys.readouterr().err
     assert "joint 1" in err and "outside" in err and "Traceback" not in err
     assert not out.exists()
@@ -220,7 +220,18 @@ def test_cli_name_with_a_control_character(tmp_path, capsys):
     text = open("examples/2a_chain.toml").read().replace('name = "2A example"', 'name = "2A \\u0007 example"')
     src, out = tmp_path / "bell.toml", tmp_path / "bell.xml"
     src.write_text(text)
-    assert main(["export", "mjcf", str(src), str(out)]) == 2
+    assert main(["export", "mjcf", str(src), "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert "name" in err and "Traceback" not in err and "\x07" not in err
     assert not out.exists()
+
+
+def test_chain_to_mjcf_passes_limits_and_outside_limits():
+    """chain.to_mjcf takes limits and outside_limits as mjcf.to_mjcf does (issue 36 item 2, 12)."""
+    chain = io.load("examples/2a_chain.toml")
+    assert chain.to_mjcf() == mjcf.to_mjcf(chain, name=chain.name)
+    assert all(j.get("range") is None for j in hinges(chain.to_mjcf(limits=False)).values())
+    q = np.array([np.nextafter(chain.limits[0, 1], 10.0), 0.0])
+    with pytest.raises(ValueError, match=r"^q: joint 1 .*outside"):
+        chain.to_mjcf(q)
+    assert "<key" in chain.to_mjcf(q, outside_limits=True)

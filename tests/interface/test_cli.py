@@ -127,14 +127,14 @@ def test_demo_without_file(capsys):
         (["fk", CHAIN2, "0.1"], "fk", r"Q: 2A example has 2 joints, got 1 angles"),
         (["fk", CHAIN2, "0.1", "0.2", "0.3"], "fk", r"Q: 2A example has 2 joints, got 3 angles"),
         (["fk", CHAIN2, "0.1", "abc"], "fk", r"Q: 'abc' is not a number"),
-        (["fk", CHAIN2, "0.1", "nan"], "fk", r"q: contains NaN"),
+        (["fk", CHAIN2, "0.1", "nan"], "fk", r"Q: 'nan' is not a finite number"),
         (["show", "nope"], "show", r"name: no derived polynomial set 'nope'"),
         (["show", "nope", "--json"], "show", r"name: no derived polynomial set 'nope'"),
         (["fk", EXAMPLES / "missing.toml", "0.1"], "fk", r"path: no such file .*missing\.toml"),
         (["demo", EXAMPLES / "missing.toml"], "demo", r"path: no such file .*missing\.toml"),
         (["ik", CHAIN4, "1", "0", "0"], "ik", r"POSE: expected 16 \(or 12\) numbers"),
         (["ik", CHAIN4, *"1 0 0 0 0 1 0 0 0 0 1 x".split()], "ik", r"POSE: 'x' is not a number"),
-        (["ik", CHAIN4, *"1 0 0 0 0 1 0 0 0 0 2 0".split()], "ik", r"T: the rotation part is not a proper rotation"),
+        (["ik", CHAIN4, *"1 0 0 0 0 1 0 0 0 0 2 0".split()], "ik", r"POSE: the rotation part is not a proper rotation"),
     ],
 )
 def test_error_exits(capsys, argv, command, message):

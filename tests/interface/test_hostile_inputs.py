@@ -168,7 +168,7 @@ def test_plot_into_an_unwritable_folder_names_the_folder_not_a_temporary_file(ca
 @pytest.mark.parametrize(
     "argv, folder",
     [
-        (["export", "mjcf", CHAIN2, "{d}"], "d"),
+        (["export", "mjcf", CHAIN2, "--out", "{d}"], "d"),
         (["view", CHAIN2, "--out", "{d}"], "d"),
         (["workspace", CHAIN2, "--samples", "1000", "--quiet", "--plot", "{d}"], "d"),
     ],
@@ -183,7 +183,10 @@ def test_every_command_refuses_a_folder_as_output(capsys, tmp_path, argv, folder
 
 @pytest.mark.parametrize(
     "argv, kind",
-    [(["export", "mjcf", CHAIN2, "{d}/m.png"], "XML model"), (["view", CHAIN2, "--out", "{d}/x.htm"], "HTML page")],
+    [
+        (["export", "mjcf", CHAIN2, "--out", "{d}/m.png"], "XML model"),
+        (["view", CHAIN2, "--out", "{d}/x.htm"], "HTML page"),
+    ],
 )
 def test_wrong_suffix_names_the_kind_of_output(capsys, tmp_path, argv, kind):
     err = one_line_error(capsys, *[a.format(d=tmp_path) for a in argv])

@@ -202,3 +202,18 @@ def test_chain_picture_is_fit_for_a_paper(tmp_path, monkeypatch):
 def test_repr_in_plot_titles_shows_the_leg_data():
     p = apair.APair(0.05, 0.04, leg_radius=0.002)
     assert "leg_radius=0.002" in repr(p)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_surface_measure_from_sparse_samples_is_positive(seed):
+    """Few samples for a surface (3000 at resolution 8): the voxel size grows until the samples
+    fill the voxels, so the length-0 extrapolation never goes negative (it gave −4.8e-5 m² for this
+    RA chain's surface). Its area is checked against the same chain sampled densely."""
+    pairs = [REV, apair.APair(0.010957233721340689, 0.007323815019344117)]
+    chain = apair.AChain(pairs, [0.039265401535042994, 0.0], np.radians([-57.6, 129.24]), [0.0, 0.0], [0.0, -0.93])
+    coarse = chain.workspace(samples=3000, resolution=8, rounds=1, seed=seed)
+    sparse = chain.workspace(samples=3000, rounds=1, seed=seed)
+    dense = chain.workspace(samples=120_000, seed=seed)
+    assert coarse.dimension == sparse.dimension == dense.dimension == 2
+    assert 0.5 * dense.measure <= coarse.measure <= 1.5 * dense.measure  # voxels 1/8 of the size
+    assert 0.85 * dense.measure <= sparse.measure <= 1.15 * dense.measure
