@@ -22,7 +22,10 @@ mass matrix, inverse and forward dynamics with
 
 checks that they all agree, and reports per-evaluation medians with min-max over repeats, ratios,
 the operation count of each generated kernel after CSE, growth with n and with the batch size,
-the time of a whole `make generate`, and inverse kinematics of 4A-chains. Results go to
+the time of a whole `make generate`, and inverse kinematics of 4A-chains. And `AChain.ik_local`
+one pose and one seed per call, as a controller calls it (alone: --ik-local-only): single calls and
+first calls on new chains, against Pinocchio's damped least-squares CLIK loop of its
+examples/inverse-kinematics.py on the R-twin chain, same poses and seeds. Results go to
 bench/results.json (or --out). Nothing here is asserted: the targets are reported as met or missed.
 """
 
@@ -599,6 +602,251 @@ def time_ik_local(rng, count: int = 2000) -> dict:
     }
 
 
+# ------------------------------------------------------------------------------------ ik_local, one pose per call
+def pin_clik(model, data, joint: int, tip, dt: float, eps: float, it_max: int):
+    """Pinocchio's damped least-squares CLIK loop as its examples/inverse-kinematics.py writes it
+    (forwardKinematics, the log6 error in the joint frame, computeJointJacobian, Jlog6, a 6 x 6
+    solve with damping 1e-12, integrate by dt), toward the pose T (4 x 4) of the frame `tip` placed
+    on joint `joint`: solve(T, q0) -> (q, converged)."""
+    import pinocchio as pin
+
+    tip_inv, eye = tip.inverse(), np.eye(6)
+
+    def solve(T, q):
+        goal = pin.SE3(T) * tip_inv  # the joint frame's pose
+        for i in range(it_max + 1):
+            pin.forwardKinematics(model, data, q)
+            iMd = data.oMi[joint].actInv(goal)
+            err = pin.log(iMd).vector
+            if np.linalg.norm(err) < eps:
+                return q, True
+            if i == it_max:
+                break
+            J = -pin.Jlog6(iMd.inverse()) @ pin.computeJointJacobian(model, data, q, joint)
+            q = pin.integrate(model, q, -dt * (J.T @ np.linalg.solve(J @ J.T + 1e-12 * eye, err)))
+        return q, False
+
+    return solve
+
+
+# the example's constants, and the same loop with full steps to ik_local's accuracy (kinder to it)
+CLIK = {"pinocchio_clik_example": (0.1, 1e-4, 1000), "pinocchio_clik_full_step": (1.0, 1e-10, 100)}
+
+
+def per_call(fn, args_list) -> dict:
+    """Median, 90th percentile and min of single calls fn(*args) [µs], one timing per call."""
+    fn(*args_list[0])
+    times = []
+    for args in args_list:
+        t0 = time.perf_counter()
+        fn(*args)
+        times.append(time.perf_counter() - t0)
+    us = np.array(times) * 1e6
+    return {
+        "calls": len(us),
+        "median_us": float(np.median(us)),
+        "p90_us": float(np.percentile(us, 90)),
+        "min_us": float(us.min()),
+    }
+
+
+def _twin(chain: apair.AChain) -> apair.AChain:
+    """A new chain object of the same design (new pairs: nothing computed yet)."""
+    pairs = [
+        apair.APair.revolute() if p.kind == "revolute" else apair.APair(p.base_radius, p.platform_radius)
+        for p in chain.pairs
+    ]
+    return apair.AChain(pairs, chain.a, chain.alpha, chain.offset, chain.theta_offset, links=chain.links)
+
+
+def _first_calls(make, T, seed, repeats: int) -> dict:
+    """Median [ms] of the first ik_local call on `repeats` new chains (make()), and of making them."""
+    build, first = [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        chain = make()
+        t1 = time.perf_counter()
+        chain.ik_local(T, seed)
+        build.append(t1 - t0)
+        first.append(time.perf_counter() - t1)
+    return {"first_call_ms": float(np.median(first) * 1e3), "build_ms": float(np.median(build) * 1e3)}
+
+
+FRESH_PROCESS = """
+import json, sys, time
+t0 = time.perf_counter()
+import numpy as np
+import apair
+t1 = time.perf_counter()
+chain = apair.load(sys.argv[1]) if sys.argv[1].endswith(".toml") else apair.AChain(
+    [apair.APair.revolute()] * 6, *json.loads(sys.argv[1]))
+q = np.full(chain.n, 0.3)
+T, seed = chain.fk(q), q + 0.05
+t2 = time.perf_counter()
+import apair.ik
+t3 = time.perf_counter()
+chain.limits
+t4 = time.perf_counter()
+chain.ik_local(T, seed)
+t5 = time.perf_counter()
+chain.ik_local(T, seed)
+t6 = time.perf_counter()
+print(json.dumps({"import_apair_ms": (t1 - t0) * 1e3, "import_apair_ik_ms": (t3 - t2) * 1e3,
+                  "limits_ms": (t4 - t3) * 1e3, "first_call_ms": (t5 - t4) * 1e3,
+                  "first_call_total_ms": (t5 - t2) * 1e3, "second_call_us": (t6 - t5) * 1e6}))
+"""
+
+
+def _fresh_process(arg: str, repeats: int) -> dict:
+    """The first ik_local call in a new Python process (after import apair and building the chain),
+    split into importing apair.ik, the chain's limits and the call itself: medians over runs [ms]."""
+    runs = []
+    for _ in range(repeats):
+        out = subprocess.run(
+            [sys.executable, "-c", FRESH_PROCESS, arg], cwd=ROOT, check=True, capture_output=True, text=True
+        )
+        runs.append(json.loads(out.stdout.splitlines()[-1]))
+    return {key: float(np.median([r[key] for r in runs])) for key in runs[0]}
+
+
+def time_ik_local_single(quick: bool, pin_ok: bool) -> dict:
+    """AChain.ik_local one pose and one seed per call from Python, as a controller calls it, on a
+    6-joint R-chain (the R-twin that Pinocchio models), seeds within 0.3 rad of a solution: single
+    calls, the batched call per pose, first calls on new chains (warm process and new process; the
+    4A example too, whose first call computes the collision limits of its pairs), and Pinocchio's
+    CLIK loop on the same poses and seeds."""
+    rng = np.random.default_rng(36)  # its own: the other sections' draws stay as they were
+    count, peer_count, repeats = (200, 50, 3) if quick else (2000, 300, 9)
+    chain = random_chain(6, rng)
+    q = rng.uniform(-np.pi + 0.3, np.pi - 0.3, (count, 6))  # the seeds stay inside the limits (-π, π)
+    T = chain.fk(q)
+    seeds = q + rng.uniform(-0.3, 0.3, q.shape)
+    out: dict = {"n": 6, "poses": count}
+    out["single"] = per_call(chain.ik_local, list(zip(T, seeds)))
+    batched = chain.ik_local(T, seeds)
+    best = min(_timed(lambda: chain.ik_local(T, seeds)) for _ in range(5))
+    out["batched_per_pose_us"] = best / count * 1e6
+    out["converged"] = float(batched.converged.mean())
+    ones = [chain.ik_local(Tk, sk) for Tk, sk in zip(T, seeds)]
+    out["single_equals_batched"] = bool(all(np.array_equal(o.q, b) for o, b in zip(ones, batched.q)))
+    out["first_call_r_twin"] = _first_calls(lambda: _twin(chain), T[0], seeds[0], repeats)
+    example = apair.load(ROOT / "examples/4a_chain.toml")
+    qe = np.full(4, 0.3)
+    out["first_call_4a_example"] = _first_calls(
+        lambda: apair.load(ROOT / "examples/4a_chain.toml"), example.fk(qe), qe + 0.05, repeats
+    )
+    fresh = min(repeats, 3)
+    design = json.dumps([chain.a.tolist(), chain.alpha.tolist(), chain.offset.tolist(), chain.theta_offset.tolist()])
+    out["fresh_process_r_twin"] = _fresh_process(design, fresh)
+    out["fresh_process_4a_example"] = _fresh_process(str(ROOT / "examples/4a_chain.toml"), fresh)
+    if pin_ok:
+        out.update(_pin_clik_rows(chain, T, seeds, batched, peer_count, repeats))
+    return out
+
+
+def _timed(fn) -> float:
+    t0 = time.perf_counter()
+    fn()
+    return time.perf_counter() - t0
+
+
+def _pin_clik_rows(chain, T, seeds, apair_result, peer_count: int, repeats: int) -> dict:
+    """Pinocchio's CLIK loops on the first peer_count poses and seeds: per call, the first call on a
+    new model (building it included), and how their solutions agree with ik_local's."""
+    rows = {}
+    model = pin_model(chain)
+    tip = model.frames[model.getFrameId("end")].placement
+    args = list(zip(T[:peer_count], seeds[:peer_count]))
+    for name, (dt, eps, it_max) in CLIK.items():
+        solve = pin_clik(model, model.createData(), chain.n, tip, dt, eps, it_max)
+        row = per_call(solve, args)
+        got = [solve(Tk, sk) for Tk, sk in args]
+        q_peer, conv = np.array([qk for qk, _ in got]), np.array([c for _, c in got])
+        diff = np.abs((q_peer - apair_result.q[:peer_count] + np.pi) % (2 * np.pi) - np.pi).max(axis=1)
+        both = conv & apair_result.converged[:peer_count]
+        row["converged"] = float(conv.mean())
+        # the peer's solutions checked by apair's fk, and how often both found the same one
+        row["peer_pose_error_max"] = float(np.abs(chain.fk(q_peer[conv]) - T[:peer_count][conv]).max())
+        row["same_solution"] = float(np.mean(diff[both] < 1e-3)) if both.any() else None  # branches differ more
+        first = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            m = pin_model(chain)
+            pin_clik(m, m.createData(), chain.n, m.frames[m.getFrameId("end")].placement, dt, eps, it_max)(*args[0])
+            first.append(time.perf_counter() - t0)
+        row["first_call_ms"] = float(np.median(first) * 1e3)
+        rows[name] = row
+    return rows
+
+
+def ik_local_targets(r: dict) -> list[dict]:
+    """Issue 36 item 3's targets for ik_local from Python, each met or missed."""
+    out = [
+        {
+            "target": "ik_local single call from Python (one pose, one seed), n = 6: <= 20 µs median",
+            "measured": r["single"]["median_us"],
+            "met": r["single"]["median_us"] <= 20,
+        },
+        {
+            "target": "ik_local first call on a new chain (6-joint R-twin, warm process): <= 50 ms",
+            "measured": r["first_call_r_twin"]["first_call_ms"],
+            "met": r["first_call_r_twin"]["first_call_ms"] <= 50,
+        },
+        {
+            "target": "ik_local first call on a new chain (examples/4a_chain.toml: its collision limits): <= 50 ms",
+            "measured": r["first_call_4a_example"]["first_call_ms"],
+            "met": r["first_call_4a_example"]["first_call_ms"] <= 50,
+        },
+    ]
+    for name in CLIK:
+        if name in r:
+            ratio = r[name]["median_us"] / r["single"]["median_us"]
+            out.append(
+                {
+                    "target": f"ik_local single call faster than Pinocchio's Python CLIK ({name}): peer / apair >= 1",
+                    "measured": ratio,
+                    "met": ratio >= 1,
+                }
+            )
+    return out
+
+
+def print_ik_local_single(r: dict) -> None:
+    s = r["single"]
+    print(
+        f"\nik_local from Python, n = {r['n']}, one pose and one seed per call ({r['poses']} poses, seeds within 0.3 rad):"
+    )
+    print(
+        f"  apair single call       median {s['median_us']:.2f} µs (p90 {s['p90_us']:.2f}, min {s['min_us']:.2f}); "
+        f"batched {r['batched_per_pose_us']:.2f} µs per pose; {r['converged']:.1%} converged; single = batched: "
+        f"{r['single_equals_batched']}"
+    )
+    for name in CLIK:
+        if name in r:
+            p = r[name]
+            same = "-" if p["same_solution"] is None else f"{p['same_solution']:.1%}"
+            print(
+                f"  {name:26s}median {p['median_us']:.1f} µs (p90 {p['p90_us']:.1f}) = {p['median_us'] / s['median_us']:.1f}x "
+                f"apair; {p['converged']:.1%} converged; largest |fk(q) - T| {p['peer_pose_error_max']:.1e}; the same solution as apair's: {same}; first call {p['first_call_ms']:.2f} ms "
+                "(model built)"
+            )
+    for key, what in (("first_call_r_twin", "6-joint R-twin"), ("first_call_4a_example", "examples/4a_chain.toml")):
+        f = r[key]
+        print(
+            f"  first call on a new chain, {what}: {f['first_call_ms']:.2f} ms (making the chain {f['build_ms']:.2f} ms)"
+        )
+    for key, what in (
+        ("fresh_process_r_twin", "6-joint R-twin"),
+        ("fresh_process_4a_example", "examples/4a_chain.toml"),
+    ):
+        f = r[key]
+        print(
+            f"  new process, {what}: first call {f['first_call_total_ms']:.0f} ms = import apair.ik "
+            f"{f['import_apair_ik_ms']:.0f} ms + limits {f['limits_ms']:.1f} ms + the call {f['first_call_ms']:.2f} ms "
+            f"(import apair before: {f['import_apair_ms']:.0f} ms); second call {f['second_call_us']:.1f} µs"
+        )
+
+
 # ------------------------------------------------------------------------------------ report
 def fmt(ns: float) -> str:
     return f"{ns / 1e6:.3g} ms" if ns >= 1e6 else f"{ns / 1e3:.3g} µs" if ns >= 1e3 else f"{ns:.3g} ns"
@@ -688,6 +936,9 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="small batches and few repeats (a smoke run)")
     ap.add_argument("--no-generate", action="store_true", help="skip timing make generate")
     ap.add_argument("--native-only", action="store_true", help="only the compiled comparison with the C/C++ peers")
+    ap.add_argument(
+        "--ik-local-only", action="store_true", help="only ik_local from Python, one pose per call, against Pinocchio"
+    )
     ap.add_argument("--out", type=Path, default=ROOT / "bench" / "results.json")
     args = ap.parse_args(argv)
     try:
@@ -719,6 +970,16 @@ def main(argv=None) -> int:
     }
     if not (pin_ok and se_ok):
         print("note: install the bench extra (pip install .[bench]) for Pinocchio and symengine", file=sys.stderr)
+    if args.ik_local_only:
+        results["ik_local_single"] = time_ik_local_single(args.quick, pin_ok)
+        results["ik_local_targets"] = ik_local_targets(results["ik_local_single"])
+        print_ik_local_single(results["ik_local_single"])
+        print("\ntargets (ik_local from Python):")
+        for t in results["ik_local_targets"]:
+            print(f"  [{'met' if t['met'] else 'MISSED'}] {t['target']}: {t['measured']:.3g}")
+        args.out.write_text(json.dumps(results, indent=1, default=_plain) + "\n")
+        print(f"written to {args.out}")
+        return 0
     results["native"] = native_section(rng, args.quick)
     results["native_targets"] = native_targets(results["native"])
     print_native(results["native"])
@@ -746,9 +1007,10 @@ def main(argv=None) -> int:
         for p in ("RRRRRR", "ARRRRR") + (() if args.quick else ("AAAAAA",))
     }
     results["ik_local"] = time_ik_local(rng)
+    results["ik_local_single"] = time_ik_local_single(args.quick, pin_ok)
     results["make_generate_s"] = None if args.no_generate else time_generate()
     results["codegen_6_s"] = time_codegen(random_achain(6, rng))
-    results["targets"] = targets(results)
+    results["targets"] = targets(results) + ik_local_targets(results["ik_local_single"])
 
     print("\nper evaluation, median over repeats (ratio = peer time / batched C time):")
     cols = [
@@ -799,6 +1061,7 @@ def main(argv=None) -> int:
         )
     r = results["ik_local"]
     print(f"  ik_local n = 6: {r['us_per_converged']:.2f} µs per converged solve ({r['converged']:.1%} converged)")
+    print_ik_local_single(results["ik_local_single"])
     if results["make_generate_s"] is not None:
         print(f"\nmake generate (derivations + code generation): {results['make_generate_s']:.1f} s")
     worst = max(

@@ -1,7 +1,8 @@
 /*
  * Private to the binding apair._native: what its translation units share. _native.c holds the
  * module (its initialisation and the kernel registry's calls), _native_chain.c the Chain type (one
- * chain's methods in one native call), _native_ik.c the inverse-kinematics solvers' marshaller.
+ * chain's methods in one native call), _native_ik.c the inverse-kinematics solvers' marshaller and
+ * LocalIK (ik_local's single-pose fast path).
  *
  * NumPy's C API in several files: every file includes this header, which names the API table
  * (PY_ARRAY_UNIQUE_SYMBOL); _native.c, which calls import_array(), defines APAIR_NATIVE_MODULE
@@ -32,7 +33,9 @@
 extern PyTypeObject apair_native_chain_type;
 PyObject *apair_native_enable(PyObject *self, PyObject *flag);
 
-/* _native_ik.c: the module's functions ik_* (NULL-terminated) */
+/* _native_ik.c: the module's functions ik_* (NULL-terminated), and the type apair._native.LocalIK
+ * (the single-pose fast path of AChain.ik_local) */
 extern PyMethodDef apair_native_ik_methods[];
+extern PyTypeObject apair_native_local_ik_type;
 
 #endif

@@ -200,7 +200,7 @@ static int chain_init(ChainObject *self, PyObject *args, PyObject *kwds)
 static int canonical(PyObject *o, PyArrayObject *like, int n)
 {
     PyArrayObject *a;
-    if (!PyArray_Check(o)) {
+    if (!PyArray_CheckExact(o)) { /* subclasses (masked arrays: their mask) take the validating path */
         return 0;
     }
     a = (PyArrayObject *)o;

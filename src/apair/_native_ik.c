@@ -12,6 +12,10 @@
  * function's count); `prepare` checks what the shapes cannot say and sets the outputs' shapes they
  * do not give. The adapter runs without the GIL where `nogil`; it returns 0 (the call returns the
  * one output, or the tuple of them), > 0 (None) or < 0 (ValueError(error)).
+ *
+ * LocalIK is the single-pose fast path of AChain.ik_local: one chain's design and limits held in
+ * C, and call(T, q0, tol, max_iter), which runs apair_ik_local on one canonical pose and seed
+ * (the numbers of ik_local's batch) or returns None for whatever the validating path must see.
  */
 #include "_native.h"
 
@@ -369,6 +373,244 @@ static PyObject *ik_local(PyObject *m, PyObject *args) { return ik_marshal(m, IK
 static PyObject *ik4_pencil(PyObject *m, PyObject *args) { return ik_marshal(m, IK4_PENCIL, args); }
 static PyObject *ik4_screen(PyObject *m, PyObject *args) { return ik_marshal(m, IK4_SCREEN, args); }
 static PyObject *ik4_left(PyObject *m, PyObject *args) { return ik_marshal(m, IK4_LEFT, args); }
+
+/* ---- LocalIK: the single-pose fast path of AChain.ik_local
+ *
+ * call(T, q0, tol, max_iter) takes exactly what the validating path (apair.ik.local.ik_local)
+ * accepts unchanged: T a float64 4 x 4 array (exactly an ndarray: no masked or other subclass),
+ * finite, last row [0, 0, 0, 1] to its tolerances, rotation orthonormal with det +1; q0 a float64
+ * (n,) array, finite, inside [lower, upper]; tol a float > 0, finite; max_iter an int in
+ * [1, max_iter of the constructor]. Anything else, and a rotation orthonormal to less than
+ * LOCAL_ORTHO (between it and the validating path's 1e-9 rounding could decide), returns None:
+ * the caller then validates, and raises the one-line ValueError that names the argument, or
+ * converts. So the two paths cannot disagree on what is an error, nor on the numbers. */
+
+#define LOCAL_NMAX 6
+#define LOCAL_ORTHO 0.5e-9          /* half of apair.ik.poses.check_matrix's tolerance 1e-9 */
+#define LOCAL_LAST_TOL 1e-12        /* check_matrix: |last row - [0, 0, 0, 1]| <= 1e-12 ... */
+#define LOCAL_LAST_TOL_ONE 1e-5     /* ... + 1e-5 for the 1 */
+
+typedef struct {
+    PyObject_HEAD
+    int n;
+    int kind[LOCAL_NMAX];
+    double pair[2 * LOCAL_NMAX], dh[4 * LOCAL_NMAX], lower[LOCAL_NMAX], upper[LOCAL_NMAX], scale;
+    long max_iter;    /* the largest max_iter accepted */
+    PyObject *result; /* called with (q, residual, converged) */
+} LocalIKObject;
+
+static int local_traverse(LocalIKObject *self, visitproc visit, void *arg)
+{
+    Py_VISIT(self->result);
+    return 0;
+}
+
+static int local_clear(LocalIKObject *self)
+{
+    Py_CLEAR(self->result);
+    return 0;
+}
+
+static void local_dealloc(LocalIKObject *self)
+{
+    PyObject_GC_UnTrack(self);
+    local_clear(self);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+/* obj as a finite array of `type` and shape (n, cols) (cols 0: (n,)) copied into out: 0, or -1
+ * with a ValueError naming it. n < 0: take n from obj and store it there. */
+static int local_design(PyObject *obj, const char *name, int type, int *n, int cols, void *out)
+{
+    PyArrayObject *a = (PyArrayObject *)PyArray_FROM_OTF(obj, type, NPY_ARRAY_IN_ARRAY);
+    int ok;
+    if (a == NULL) {
+        return -1;
+    }
+    if (*n < 0 && PyArray_NDIM(a) == 1) {
+        *n = (int)(PyArray_DIM(a, 0) <= LOCAL_NMAX ? PyArray_DIM(a, 0) : LOCAL_NMAX + 1);
+    }
+    ok = *n >= 1 && *n <= LOCAL_NMAX && PyArray_NDIM(a) == (cols ? 2 : 1) && PyArray_DIM(a, 0) == *n &&
+         (!cols || PyArray_DIM(a, 1) == cols);
+    if (ok && type == NPY_DOUBLE) {
+        const double *x = (const double *)PyArray_DATA(a);
+        for (npy_intp k = 0; k < PyArray_SIZE(a); k++) {
+            ok = ok && isfinite(x[k]);
+        }
+    }
+    if (ok) {
+        memcpy(out, PyArray_DATA(a), (size_t)PyArray_NBYTES(a));
+    } else {
+        PyErr_Format(PyExc_ValueError, "LocalIK: %s is not a finite array of shape (n%s) with 1 <= n <= %d", name,
+                     cols == 2 ? ", 2" : cols == 4 ? ", 4" : ",", LOCAL_NMAX);
+    }
+    Py_DECREF(a);
+    return ok ? 0 : -1;
+}
+
+/* LocalIK(kind, pair, dh, lower, upper, scale, max_iter, result): as ik_local takes them. */
+static int local_init(LocalIKObject *self, PyObject *args, PyObject *kwds)
+{
+    PyObject *kind, *pair, *dh, *lower, *upper, *result;
+    double scale;
+    long max_iter;
+    int n = -1;
+    (void)kwds;
+    if (!PyArg_ParseTuple(args, "OOOOOdlO", &kind, &pair, &dh, &lower, &upper, &scale, &max_iter, &result)) {
+        return -1;
+    }
+    if (self->result != NULL) { /* call() reads the design without the GIL: it never changes */
+        PyErr_SetString(PyExc_TypeError, "LocalIK: already initialised");
+        return -1;
+    }
+    if (!PyCallable_Check(result)) {
+        PyErr_SetString(PyExc_TypeError, "LocalIK: result must be callable");
+        return -1;
+    }
+    if (local_design(kind, "kind", NPY_INT32, &n, 0, self->kind) || local_design(pair, "pair", NPY_DOUBLE, &n, 2, self->pair) ||
+        local_design(dh, "dh", NPY_DOUBLE, &n, 4, self->dh) || local_design(lower, "lower", NPY_DOUBLE, &n, 0, self->lower) ||
+        local_design(upper, "upper", NPY_DOUBLE, &n, 0, self->upper)) {
+        return -1;
+    }
+    for (int i = 0; i < n; i++) {
+        if (self->kind[i] < 0 || self->kind[i] > 2 || !(self->lower[i] <= self->upper[i])) {
+            PyErr_Format(PyExc_ValueError, "LocalIK: joint %d has kind %d (0, 1 or 2) and range (%g, %g)", i + 1,
+                         self->kind[i], self->lower[i], self->upper[i]);
+            return -1;
+        }
+    }
+    if (!(scale > 0.0) || !isfinite(scale) || max_iter < 1 || max_iter > INT_MAX) {
+        PyErr_SetString(PyExc_ValueError, "LocalIK: expected a finite scale > 0 and 1 <= max_iter <= INT_MAX");
+        return -1;
+    }
+    self->n = n;
+    self->scale = scale;
+    self->max_iter = max_iter;
+    Py_INCREF(result);
+    self->result = result;
+    return 0;
+}
+
+/* obj as a float64 array of exactly `size` doubles of shape (size,) or (4, 4) (nd), canonical
+ * (native byte order, C-contiguous, aligned, an ndarray itself), copied into out: 1, else 0. */
+static int local_canonical(PyObject *obj, int nd, npy_intp size, double *out)
+{
+    PyArrayObject *a = (PyArrayObject *)obj;
+    if (!PyArray_CheckExact(obj) || PyArray_TYPE(a) != NPY_DOUBLE || !PyArray_ISNOTSWAPPED(a) ||
+        !PyArray_IS_C_CONTIGUOUS(a) || !PyArray_ISALIGNED(a) || PyArray_NDIM(a) != nd || PyArray_SIZE(a) != size ||
+        (nd == 2 && PyArray_DIM(a, 0) != 4)) {
+        return 0;
+    }
+    memcpy(out, PyArray_DATA(a), sizeof(double) * (size_t)size);
+    for (npy_intp k = 0; k < size; k++) {
+        if (!isfinite(out[k])) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Whether T (4 x 4, finite) is clearly a rigid transform by check_matrix's tests. */
+static int local_rigid(const double *T)
+{
+    const double *R[3] = {T, T + 4, T + 8};
+    double det;
+    if (!(fabs(T[12]) <= LOCAL_LAST_TOL && fabs(T[13]) <= LOCAL_LAST_TOL && fabs(T[14]) <= LOCAL_LAST_TOL &&
+          fabs(T[15] - 1.0) <= LOCAL_LAST_TOL + LOCAL_LAST_TOL_ONE)) {
+        return 0;
+    }
+    for (int a = 0; a < 3; a++) {
+        for (int b = 0; b < 3; b++) {
+            double s = R[0][a] * R[0][b] + R[1][a] * R[1][b] + R[2][a] * R[2][b] - (a == b ? 1.0 : 0.0);
+            if (!(fabs(s) <= LOCAL_ORTHO)) {
+                return 0;
+            }
+        }
+    }
+    det = R[0][0] * (R[1][1] * R[2][2] - R[1][2] * R[2][1]) - R[0][1] * (R[1][0] * R[2][2] - R[1][2] * R[2][0]) +
+          R[0][2] * (R[1][0] * R[2][1] - R[1][1] * R[2][0]);
+    return det > 0.5; /* orthonormal to LOCAL_ORTHO: det is +-1 to about 1e-9 */
+}
+
+static PyObject *local_call(LocalIKObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    double T[16], q0[LOCAL_NMAX], tol;
+    long max_iter;
+    int overflow = 0, converged = 0, rc;
+    npy_intp n = self->n;
+    PyObject *out[3], *result;
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "LocalIK.call(T, q0, tol, max_iter)");
+        return NULL;
+    }
+    if (self->result == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "LocalIK: not initialised");
+        return NULL;
+    }
+    if (!local_canonical(args[0], 2, 16, T) || !local_rigid(T) || !local_canonical(args[1], 1, n, q0) ||
+        !PyFloat_Check(args[2]) || !PyLong_Check(args[3]) || PyBool_Check(args[3])) {
+        Py_RETURN_NONE;
+    }
+    for (int i = 0; i < self->n; i++) {
+        if (!(q0[i] >= self->lower[i] && q0[i] <= self->upper[i])) {
+            Py_RETURN_NONE;
+        }
+    }
+    tol = PyFloat_AS_DOUBLE(args[2]);
+    max_iter = PyLong_AsLongAndOverflow(args[3], &overflow);
+    if (!(tol > 0.0) || !isfinite(tol) || overflow || max_iter < 1 || max_iter > self->max_iter) {
+        if (PyErr_Occurred()) {
+            return NULL;
+        }
+        Py_RETURN_NONE;
+    }
+    out[0] = PyArray_SimpleNew(1, &n, NPY_DOUBLE);
+    out[1] = PyArray_SimpleNew(0, NULL, NPY_DOUBLE);
+    out[2] = PyArray_SimpleNew(0, NULL, NPY_BOOL);
+    if (out[0] == NULL || out[1] == NULL || out[2] == NULL) {
+        Py_XDECREF(out[0]);
+        Py_XDECREF(out[1]);
+        Py_XDECREF(out[2]);
+        return NULL;
+    }
+    {
+        const apair_ik_chain ch = {self->n, self->kind, self->pair, self->dh, self->lower, self->upper, self->scale};
+        double *q = (double *)PyArray_DATA((PyArrayObject *)out[0]), *residual = (double *)PyArray_DATA((PyArrayObject *)out[1]);
+        Py_BEGIN_ALLOW_THREADS
+        rc = apair_ik_local(&ch, 1, T, 0, q0, (ptrdiff_t)self->n, tol, (int)max_iter, q, residual, &converged);
+        Py_END_ALLOW_THREADS
+    }
+    *(npy_bool *)PyArray_DATA((PyArrayObject *)out[2]) = converged != 0;
+    result = rc == 0 ? PyObject_Vectorcall(self->result, out, 3, NULL) : NULL;
+    if (rc != 0) {
+        PyErr_SetString(PyExc_ValueError, "ik_local: the chain is not valid (kinds 0, 1 or 2; 1 to 6 joints)");
+    }
+    Py_DECREF(out[0]);
+    Py_DECREF(out[1]);
+    Py_DECREF(out[2]);
+    return result;
+}
+
+static PyMethodDef local_methods[] = {
+    {"call", (PyCFunction)(void (*)(void))local_call, METH_FASTCALL,
+     "call(T, q0, tol, max_iter) -> result(q, residual, converged), or None when the inputs need the validating path."},
+    {NULL, NULL, 0, NULL},
+};
+
+PyTypeObject apair_native_local_ik_type = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "apair._native.LocalIK",
+    .tp_basicsize = sizeof(LocalIKObject),
+    .tp_dealloc = (destructor)local_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_HAVE_GC,
+    .tp_doc = "LocalIK(kind, pair, dh, lower, upper, scale, max_iter, result): the single-pose fast path of "
+              "AChain.ik_local (apair.ik.local.local_solver).",
+    .tp_traverse = (traverseproc)local_traverse,
+    .tp_clear = (inquiry)local_clear,
+    .tp_methods = local_methods,
+    .tp_init = (initproc)local_init,
+    .tp_new = PyType_GenericNew,
+};
 
 PyMethodDef apair_native_ik_methods[] = {
     {"ik_track_slice", ik_track_slice, METH_VARARGS,

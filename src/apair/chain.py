@@ -57,6 +57,7 @@ class AChain:
     (lo, hi) or None for the pair's own (see `limits`)."""
 
     name: str  # the chain file's name or stem, set by apair.io.load (absent on a chain made here)
+    _local_ik: Any = None  # ik_local's native fast path (apair._native.LocalIK), set up by its first call
 
     def __init__(
         self,
@@ -118,6 +119,7 @@ class AChain:
     def __getstate__(self) -> dict[str, Any]:
         state = dict(self.__dict__)
         del state["_fast"], state["_call"]  # native objects: rebuilt on unpickling
+        state.pop("_local_ik", None)  # ik_local's, set up again by its first call
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -343,14 +345,25 @@ class AChain:
         path: str | os.PathLike[str] | None = None,
         overwrite: bool = False,
         collisions: bool = False,
+        limits: bool = True,
+        outside_limits: bool = False,
     ) -> str:
         """The MuJoCo model (MJCF) of the mechanism, every A-pair as its Griffis-Duffy platform with
         six legs closed by equality constraints (apair.mjcf); keyframe 0 is q (default: all zero).
-        Written to `path` too if given (an existing file only with overwrite=True). Returns the XML."""
+        `limits`: the hinges carry the chain's collision limits as ranges (False: none). A q past
+        those limits (legs colliding) is refused unless `outside_limits`. Written to `path` too if
+        given (an existing file only with overwrite=True). Returns the XML."""
         from . import mjcf
 
         collisions = V.flag("collisions", collisions)
-        xml = mjcf.to_mjcf(self, q, name=getattr(self, "name", None) or "apair chain", collisions=collisions)
+        xml = mjcf.to_mjcf(
+            self,
+            q,
+            name=getattr(self, "name", None) or "apair chain",
+            collisions=collisions,
+            limits=limits,
+            outside_limits=outside_limits,
+        )
         if path is not None:
             write_text(path, xml, overwrite, ".xml")
         return xml
@@ -478,10 +491,19 @@ class AChain:
         """The solution nearest (in the damped least-squares sense) to each seed: Levenberg-Marquardt
         from q0 (n,) or (..., n) to T (4, 4) or (..., 4, 4), broadcast together, every step kept
         inside `limits`; in C on the fk and Jacobian kernels. Returns `apair.ik.LocalSolution`
-        (q, residual = largest entry of |fk(q) − T|, converged = residual ≤ tol). Any n, any pairs."""
-        from .ik import ik_local
+        (q, residual = largest entry of |fk(q) − T|, converged = residual ≤ tol). Any n, any pairs.
+        One float64 pose and seed (a controller's call) take one native call once the first call
+        has set the chain's fast path up (apair.ik.local.local_solver); the same numbers."""
+        if self._local_ik is not None:
+            out: LocalSolution | None = self._local_ik.call(T, q0, tol, max_iter)
+            if out is not None:
+                return out
+        from .ik.local import ik_local, local_solver
 
-        return ik_local(self, T, q0, tol=tol, max_iter=V.integer("max_iter", max_iter, maximum=MAX_ITER))
+        out = ik_local(self, T, q0, tol=tol, max_iter=V.integer("max_iter", max_iter, maximum=MAX_ITER))
+        if self._local_ik is None:
+            self._local_ik = local_solver(self, MAX_ITER)
+        return out
 
     def workspace(
         self,

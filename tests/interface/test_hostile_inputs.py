@@ -96,6 +96,10 @@ def test_masked_arrays_are_refused(method):
     q = np.ma.masked_array([0.1, np.nan], mask=[False, True])
     with pytest.raises(ValueError, match="^q: masked arrays are not accepted"):
         getattr(c, method)(q)
+    getattr(c, method)(np.zeros(2))  # the native single-pose path is set up now: it refuses them too
+    for values in ([0.1, np.nan], [0.1, 0.2]):
+        with pytest.raises(ValueError, match="^q: masked arrays are not accepted"):
+            getattr(c, method)(np.ma.masked_array(values, mask=[False, True]))
 
 
 def test_masked_pose_is_refused_by_ik():
