@@ -8,7 +8,7 @@ DEPS_STAMP := $(VENV)/.deps-stamp
 CFLAGS_STRICT := -std=c99 -Wall -Wextra -Werror -pedantic -O2
 CHECK_DIR := build/check-generated
 
-.PHONY: all venv generate install varieties lib examples demo check test test-fast lint docs bench clean ik-counts browser pictures
+.PHONY: all venv generate install varieties lib examples demo check test test-fast lint docs bench clean ik-counts browser pictures clang
 
 all: generate install varieties lib examples demo
 
@@ -75,7 +75,7 @@ check: install
 	diff -r $(EXAMPLE_CODE) $(CHECK_DIR)-example || \
 	  (echo "$(EXAMPLE_CODE) is out of date: run make examples and commit" >&2; exit 1)
 
-test: install lib check browser
+test: install lib check browser clang
 	$(PY) -m pytest -q
 
 # The fast tier (a few minutes): every test not marked slow, without regenerating generated/.
@@ -94,14 +94,16 @@ lint: $(DEPS_STAMP)
 docs: $(DEPS_STAMP)
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
-# The viewer's test drives Debian's Chromium (Playwright, from the test extra, launches it):
-# installed here from the system packages when it is missing.
-CHROMIUM := /usr/bin/chromium
-browser: $(CHROMIUM)
-$(CHROMIUM):
-	@echo "installing Chromium (Debian package chromium) for the browser test"
-	@if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
-	  $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq --no-install-recommends chromium
+# The system programs the tests drive, found or installed by tests/sysdeps.py. A Chromium for the
+# viewer's browser test (Playwright, from the test extra, launches it): $CHROMIUM, else one on PATH,
+# else Playwright's own; else Debian's package chromium (apt-get as root, or with a sudo that asks for
+# no password), else Playwright's download into ~/.cache (no root); else it stops with the commands to
+# run. clang for the C checks: Debian's clang and libclang-rt-dev the same way, else a note (those
+# checks are then skipped, saying so).
+browser: $(DEPS_STAMP)
+	@$(PY) tests/sysdeps.py browser
+clang:
+	@$(PYTHON) tests/sysdeps.py clang
 
 # The documentation's pictures of the MuJoCo model and the viewer (off-screen OpenGL by EGL, Chromium).
 pictures: install browser

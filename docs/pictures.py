@@ -6,6 +6,7 @@ headless Chromium. Not part of `make`: off-screen OpenGL is not on every machine
 """
 
 import os
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -47,7 +48,7 @@ def viewer_shot(chain):
         page_file = view.write(chain, Path(tmp) / "view.html", workspace=3000)
         with sync_playwright() as p:
             b = p.chromium.launch(
-                executable_path="/usr/bin/chromium",
+                executable_path=os.environ.get("CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium",
                 args=["--no-sandbox", "--disable-gpu", "--disable-background-networking"],
             )
             page = b.new_page(viewport={"width": 1000, "height": 560})

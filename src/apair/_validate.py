@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -35,6 +37,45 @@ def shorten(text: str, limit: int = 80) -> str:
     """One line of at most `limit` characters, for a value quoted in an error message."""
     line = " ".join(text.split())
     return line if len(line) <= limit else line[: limit - 3] + "..."
+
+
+# Characters no text field holds: control characters (C0, tab and newlines included, DEL, C1), lone
+# surrogates (no UTF-8 file can hold them) and Unicode's 66 non-characters (U+FDD0..U+FDEF and the
+# last two code points of every plane). Writers of XML, JSON, HTML, C or TOML could not carry them
+# intact, and a terminal would act on them. A multi-line field (a description) takes tab and newline.
+_NONCHARACTERS = "\ufdd0-\ufdef" + "".join(f"{chr(p + 0xFFFE)}{chr(p + 0xFFFF)}" for p in range(0, 0x110000, 0x10000))
+_REFUSED_TEXT = re.compile(f"[\x00-\x1f\x7f-\x9f\ud800-\udfff{_NONCHARACTERS}]")
+_REFUSED_LINES = re.compile(f"[\x00-\x08\x0b-\x1f\x7f-\x9f\ud800-\udfff{_NONCHARACTERS}]")
+
+
+def _what(ch: str) -> str:
+    """The kind of a refused character, for a message."""
+    if "\ud800" <= ch <= "\udfff":
+        return "lone surrogate"
+    return "control character" if ord(ch) <= 0x9F else "non-character"
+
+
+def text(name: str, value: object, *, multiline: bool = False) -> str:
+    """A text field (a chain's name, its description): a str without the characters that
+    `_REFUSED_TEXT` lists (`multiline`: tab and newline allowed). The message names the field,
+    the code point and where it is (character k, counted from 1), never the character itself."""
+    if not isinstance(value, str):
+        raise ValueError(f"{name}: expected a string, got {shorten(repr(value))}")
+    bad = (_REFUSED_LINES if multiline else _REFUSED_TEXT).search(value)
+    if bad is not None:
+        k, line = bad.start(), value.count("\n", 0, bad.start())
+        column = k - value.rfind("\n", 0, k)  # from 1 (rfind gives -1 on the first line)
+        where = f"line {line + 1}, character {column}" if line else f"character {column}"
+        raise ValueError(
+            f"{name}: holds the {_what(bad.group())} U+{ord(bad.group()):04X} at {where}; use printable characters"
+        )
+    return value
+
+
+def replace_refused(value: str) -> str:
+    """value with every character that a one-line text field refuses replaced by U+FFFD: a
+    default made of text nobody typed (a file name) is made usable, not refused."""
+    return _REFUSED_TEXT.sub("\ufffd", value)
 
 
 def real_array(

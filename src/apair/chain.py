@@ -56,7 +56,18 @@ class AChain:
     theta_offset (φ). Angles in radians, lengths in metres. `limits`: per joint an explicit range
     (lo, hi) or None for the pair's own (see `limits`)."""
 
-    name: str  # the chain file's name or stem, set by apair.io.load (absent on a chain made here)
+    _name: str | None = None
+
+    @property
+    def name(self) -> str | None:
+        """The chain's name (a chain file's `name` or file stem; None on a chain made here until
+        set); a text field (docs/conventions.md): control characters are refused."""
+        return self._name
+
+    @name.setter
+    def name(self, value: str) -> None:
+        self._name = V.text("name", value)
+
     _local_ik: Any = None  # ik_local's native fast path (apair._native.LocalIK), set up by its first call
 
     def __init__(
@@ -215,7 +226,7 @@ class AChain:
         """A validated q with the angles past a range end by rounding put on it (each pair with
         a restricted range checks its angles)."""
         for i in self._ranged:
-            snapped = self.pairs[i]._theta(q[..., i], name=f"q[..., {i}]")
+            snapped = self.pairs[i]._theta(q[..., i], name=f"q[..., {i}] (joint {i + 1})")
             if not np.array_equal(snapped, q[..., i]):
                 q = q.copy()
                 q[..., i] = snapped

@@ -1,6 +1,6 @@
 """Chains from TOML files (the format is documented in README.md, "Chain files").
 
-name = "a 2A-chain"            # optional
+name = "a 2A-chain"            # optional; description = "..." optional (may span lines)
 [[joint]]                      # one table per joint, base to tip
 pair = "sinusoidal"            # "sinusoidal" | "general" | "revolute"
 base_radius = 0.05             # A-pairs: triangle circumradii [m]
@@ -22,8 +22,10 @@ gravity = [0, 0, -9.81]        # top level, optional [m/s^2]
 
 from __future__ import annotations
 
+import difflib
 import math
 import os
+import re
 import reprlib
 import tomllib
 from collections.abc import Sequence
@@ -46,6 +48,69 @@ _PAIR_KEYS = {
 }
 _DH_KEYS = {"a", "alpha", "alpha_deg", "offset", "theta_offset", "theta_offset_deg", "limits", "limits_deg"}
 _LINK_KEYS = {"mass", "com", "inertia"}
+_JOINT_KEYS = set().union(*_PAIR_KEYS.values()) | _DH_KEYS | _LINK_KEYS | {"pair"}
+_TOP_KEYS = {"name", "description", "gravity", "joint"}
+TURN = 2 * math.pi  # an angle in radians beyond ±TURN is surely one in degrees
+
+
+def _key(k: str) -> str:
+    """A key as a message prints it: plainly if it is a short run of printable characters, else
+    its repr (shortened)."""
+    plain = k.isprintable() and 0 < len(k) <= 40 and not any(c.isspace() for c in k)
+    return k if plain else _short(k)
+
+
+def _elsewhere(key: str, kind: str | None) -> str | None:
+    """Where a key that is not valid here (a joint of `kind`, or the top of the file for None)
+    belongs, as a message says it; None for a key valid nowhere."""
+    if kind is None:
+        return "belongs in a [[joint]] table" if key in _JOINT_KEYS else None
+    if key in _TOP_KEYS:
+        return "belongs at the top of the file, not in a [[joint]] table"
+    kinds = [k for k in KINDS if key in _PAIR_KEYS[k]]
+    return f"is not a key of a {kind} pair (only of a {' or '.join(kinds)} pair)" if kinds else None
+
+
+def _guessed(keys: Sequence[str], valid: set[str]) -> str:
+    """The words for keys valid nowhere: `unknown key k; did you mean g?` (or `unknown keys k1
+    (did you mean g?), k2`), g the nearest valid key where one is near."""
+    guesses = [(_key(k), difflib.get_close_matches(k, sorted(valid), n=1)) for k in keys]
+    if len(guesses) == 1:
+        k, near = guesses[0]
+        return f"unknown key {k}" + (f"; did you mean {near[0]}?" if near else "")
+    return "unknown keys " + ", ".join(k + (f" (did you mean {near[0]}?)" if near else "") for k, near in guesses)
+
+
+def _check_keys(where: str, keys: Sequence[str], valid: set[str], kind: str | None = None) -> None:
+    """Refuses the keys not in `valid`, each with the place it belongs to (`_elsewhere`) or the
+    nearest valid key as a hint (`_guessed`); at most three are named."""
+    unknown = sorted(set(keys) - valid)
+    if not unknown:
+        return
+    named = unknown[:3]
+    placed = [(k, _elsewhere(k, kind)) for k in named]
+    said = [f"{_key(k)} {place}" for k, place in placed if place is not None]
+    guess = [k for k, place in placed if place is None]
+    if guess:
+        said.append(_guessed(guess, valid))
+    more = f" (and {len(unknown) - 3} more)" if len(unknown) > 3 else ""
+    raise ValueError(f"{where}: {'; '.join(said)}{more}")
+
+
+def _toml_value(v: object) -> str:
+    """A number or list of numbers as TOML writes it (for a hint)."""
+    if isinstance(v, list):
+        return "[" + ", ".join(map(_toml_value, v)) + "]"
+    return _short(v)
+
+
+def _check_turn(where: str, key: str, raw: object, values: NDArray[np.float64]) -> None:
+    """Refuses an angle in radians beyond a turn: surely degrees given under the radians key."""
+    if np.any(np.abs(values) > TURN):
+        shown = _toml_value(raw)
+        raise ValueError(
+            f"{where}.{key}: {shown} is more than a turn (2 pi) in radians; did you mean {key}_deg = {shown}?"
+        )
 
 
 def _fits(v: object, shape: tuple[int, ...]) -> bool:
@@ -92,7 +157,9 @@ def _angle(where: str, j: dict[str, Any], key: str, default: float | None = None
         _number(f"{where}.{key}_deg", v)
         return math.radians(v)
     if key in j:
-        return _number(f"{where}.{key}", j[key])
+        x = _number(f"{where}.{key}", j[key])
+        _check_turn(where, key, j[key], np.array(x))
+        return x
     if default is None:
         raise ValueError(f"{where}: missing {key} (or {key}_deg)")
     return default
@@ -105,7 +172,9 @@ def _limits(where: str, j: dict[str, Any], pair: APair) -> tuple[float, float] |
         raise ValueError(f"{where}: give limits or limits_deg, not both")
     for key, unit, scale in (("limits", "rad", 1.0), ("limits_deg", "deg", math.pi / 180)):
         if key in j:
-            lo, hi = _numbers(f"{where}.{key}", j[key], [(2,)])
+            lo, hi = values = _numbers(f"{where}.{key}", j[key], [(2,)])
+            if key == "limits":
+                _check_turn(where, key, j[key], values)
             if not lo < hi:
                 raise ValueError(f"{where}.{key}: expected lo < hi, got ({lo:g}, {hi:g}) {unit}")
             try:
@@ -167,10 +236,10 @@ def _joint(w: str, j: object) -> tuple[APair, float, float, float, float, Link]:
         raise ValueError(f"{w}: expected a [[joint]] table, got {_short(j)}")
     kind = j.get("pair")
     if kind not in KINDS:
-        raise ValueError(f"{w}.pair: expected one of {KINDS}, got {_short(kind)}")
-    unknown = set(j) - (_PAIR_KEYS[kind] | _DH_KEYS | _LINK_KEYS | {"pair"})
-    if unknown:
-        raise ValueError(f"{w}: keys {_short(sorted(unknown))} are not valid for a {kind} pair")
+        near = difflib.get_close_matches(kind, KINDS, n=1) if isinstance(kind, str) else []
+        hint = f"; did you mean {near[0]}?" if near else ""
+        raise ValueError(f"{w}.pair: expected one of {KINDS}, got {_short(kind)}{hint}")
+    _check_keys(w, list(j), _PAIR_KEYS[kind] | _DH_KEYS | _LINK_KEYS | {"pair"}, kind)
     pair = _pair(w, j, kind)
     if "a" not in j:
         raise ValueError(f"{w}: missing a")
@@ -181,12 +250,16 @@ def _joint(w: str, j: object) -> tuple[APair, float, float, float, float, Link]:
 
 
 def chain_from_dict(data: dict[str, Any], where: str = "chain") -> AChain:
-    """Build an AChain from the parsed TOML document. Sizes are checked first (the number of
-    joints, every list's shape), before any work on the contents, and the joints' ranges last
-    (they need the pairs' collision limits, the slow part)."""
-    unknown = set(data) - {"name", "joint", "description", "gravity"}
-    if unknown:
-        raise ValueError(f"{where}: unknown keys {_short(sorted(unknown))}")
+    """Build an AChain from the parsed TOML document (named by its `name` if it has one). Keys
+    and text fields are checked first, then sizes (the number of joints, every list's shape),
+    before any work on the contents, and the joints' ranges last (they need the pairs' collision
+    limits, the slow part). `where` begins every message (the file's name)."""
+    _check_keys(where, list(data), _TOP_KEYS)
+    name = data.get("name")
+    if name is not None:
+        V.text(f"{where}: name", name)
+    if "description" in data:
+        V.text(f"{where}: description", data["description"], multiline=True)
     joints = data.get("joint")
     if not isinstance(joints, list) or not joints:
         raise ValueError(f"{where}: needs at least one [[joint]] table")
@@ -198,16 +271,58 @@ def chain_from_dict(data: dict[str, Any], where: str = "chain") -> AChain:
     pairs, a, alpha, offset, theta_offset, links = zip(*(_joint(w, j) for w, j in zip(names, joints)))
     limits = [_limits(w, j, pair) for w, j, pair in zip(names, joints, pairs)]
     try:
-        return AChain(pairs, a, alpha, offset, theta_offset, links=links, gravity=gravity, limits=limits)
+        chain = AChain(pairs, a, alpha, offset, theta_offset, links=links, gravity=gravity, limits=limits)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
+    if name is not None:
+        chain.name = name
+    return chain
 
 
 MAX_FILE_BYTES = 16 * 2**20  # a chain file is a few kB; anything this large is not one
 
 
+def _toml_reason(exc: tomllib.TOMLDecodeError) -> str:
+    """tomllib's message with its place as "(line L, column C)" or "(at the end of the file)"."""
+    msg = str(exc)
+    at = re.fullmatch(r"(.*) \(at line (\d+), column (\d+)\)", msg, re.DOTALL)
+    if at:
+        return f"{at[1]} (line {at[2]}, column {at[3]})"
+    return re.sub(r" \(at end of document\)$", " (at the end of the file)", msg)
+
+
+def _parse(text: str, where: str) -> dict[str, Any]:
+    """The TOML document of a chain file's text; `where` names the file in messages."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{where}: not valid TOML: {V.shorten(_toml_reason(exc), 200)}") from None
+    except RecursionError:
+        raise ValueError(f"{where}: nested too deeply to be a chain file") from None
+
+
+def _printed(path: Path) -> str:
+    """A file's name as messages print it: plainly, or as its repr if it holds a character that
+    a text field refuses (a newline would break the one-line message)."""
+    text = str(path)
+    return text if V.replace_refused(text) == text else V.shorten(repr(text), 120)
+
+
+def loads(text: str, where: str = "chain") -> AChain:
+    """Read a chain from the text of a chain file; `where` begins every message (a file name).
+    The chain is named by the text's `name`, and has no name without one."""
+    V.text("where", where)
+    if not isinstance(text, str):
+        raise ValueError(f"text: expected the text of a chain file (a str), got {type(text).__name__}")
+    if len(text) > MAX_FILE_BYTES:
+        raise ValueError(f"text: longer than {MAX_FILE_BYTES // 2**20} MiB, not a chain file")
+    return chain_from_dict(_parse(text, where), where)
+
+
 def load(path: str | os.PathLike[str]) -> AChain:
-    """Read a chain from a TOML file (UTF-8, a byte-order mark allowed)."""
+    """Read a chain from a TOML file (UTF-8, a byte-order mark allowed). The chain is named by
+    the file's `name`, or else by the file's name without its suffix (characters a name cannot
+    hold replaced by U+FFFD)."""
     if not isinstance(path, (str, os.PathLike)):
         raise ValueError(f"path: expected a file name, got {_short(path)}")
     p = Path(path)
@@ -217,21 +332,17 @@ def load(path: str | os.PathLike[str]) -> AChain:
         raise ValueError(f"path: {str(p)!r} is a folder, not a chain file")
     if not p.is_file():
         raise ValueError(f"path: {str(p)!r} is not a regular file (a FIFO, socket or device)")
+    where = _printed(p)
     try:
         if p.stat().st_size > MAX_FILE_BYTES:
             raise ValueError(f"path: {str(p)!r} is larger than {MAX_FILE_BYTES // 2**20} MiB, not a chain file")
-        data = tomllib.loads(p.read_text(encoding="utf-8-sig"))
+        text = p.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise ValueError(f"path: {p} is not UTF-8 text: {exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"path: {p} is not valid TOML: {exc}") from None
-    except RecursionError:
-        raise ValueError(f"path: {p} is nested too deeply to be a chain file") from None
+        raise ValueError(f"{where}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
     except OSError as exc:
         raise ValueError(f"path: cannot read {str(p)!r}: {exc.strerror or exc}") from None
-    name = data.get("name", p.stem)
-    if not isinstance(name, str):
-        raise ValueError(f"{p}: name: expected a string, got {_short(name)}")
-    chain = chain_from_dict(data, where=str(p))
-    chain.name = name
+    data = _parse(text, where)
+    chain = chain_from_dict(data, where)
+    if "name" not in data:
+        chain.name = V.replace_refused(p.stem)
     return chain

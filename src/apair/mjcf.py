@@ -31,7 +31,6 @@ of 1e-2 times that (kg m²); both change the dynamics by about MASSLESS.
 from __future__ import annotations
 
 import math
-import unicodedata
 from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
 
@@ -121,23 +120,9 @@ def _check_within_limits(chain: ChainLike, q: NDArray[np.float64]) -> None:
             )
 
 
-def _xml_safe(ch: str) -> bool:
-    """Whether XML 1.0 text may hold the character, control characters (C0 including tab and
-    newlines, DEL, C1) left out: they have no place in a name."""
-    return unicodedata.category(ch) not in ("Cc", "Cs") and ch not in "\ufffe\uffff"
-
-
 def _check_name(name: object) -> str:
     """The model's name, refused if it holds a character that XML cannot (or should not) carry."""
-    if not isinstance(name, str):
-        raise ValueError(f"name: expected a string, got {V.shorten(repr(name))}")
-    for k, ch in enumerate(name):
-        if not _xml_safe(ch):
-            raise ValueError(
-                f"name: holds the control or non-XML character U+{ord(ch):04X} at position {k}; "
-                "use printable characters"
-            )
-    return name
+    return V.text("name", name)
 
 
 def state(

@@ -26,19 +26,12 @@ KINDS = ("sinusoidal", "general", "revolute")
 _SINUSOIDAL_RTOL = 1e-12  # |a - b| <= this * b: the leg length is the sinusoidal one
 
 
-LENGTH_RANGE = (1e-150, 1e150)  # [m]: lengths whose squares and products are normal doubles
-
-
 def _length(name: str, value: ArrayLike, positive: bool = False) -> float:
-    """A length [m] inside LENGTH_RANGE (0 allowed unless positive): outside it the pair's
-    constants (L², r_b·r_p) overflow or underflow and no finite answer exists."""
+    """A length [m]: 0 (unless positive) or of magnitude in the range apair computes in
+    (V.LENGTH_RANGE), where the pair's constants (squares and products of lengths) and a chain's
+    dynamics stay normal doubles."""
     x = V.scalar(name, value, positive=positive, nonnegative=True)
-    lo, hi = LENGTH_RANGE
-    if x > hi or (x != 0 and x < lo):
-        raise ValueError(
-            f"{name}: {x!r} m is outside the range {lo:g} .. {hi:g} m in which the pair's "
-            "constants (squares and products of lengths) are finite doubles"
-        )
+    V.in_range(name, x, "m")
     return x
 
 
@@ -76,6 +69,7 @@ class APair:
         r_b = _length("base_radius", base_radius, positive=True)
         r_p = _length("platform_radius", platform_radius, positive=True)
         self.leg_mass = V.scalar("leg_mass", leg_mass, nonnegative=True)
+        V.in_range("leg_mass", self.leg_mass, "kg")
         self.leg_radius = _length("leg_radius", leg_radius)
         self.thickness = _length("thickness", thickness)
         self._limits: CollisionLimits | None = None
@@ -184,7 +178,7 @@ class APair:
                 if np.any(far):
                     raise ValueError(
                         f"{name}: outside this pair's range |theta| <= {self.theta_limit:.12g} (mod 2 pi), "
-                        f"e.g. {th[far].flat[0]!r}"
+                        f"e.g. {float(th[far].flat[0]):.12g}"
                     )
                 turns = 2 * np.pi * np.round(th / (2 * np.pi))
                 th = np.where(bad, turns + np.copysign(cast(float, self.theta_limit), th - turns), th)

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ._validate import shorten
+from . import _validate as V
 from .files import cache_root, toolkit_digest
 
 if TYPE_CHECKING:
@@ -83,7 +83,7 @@ def check_prefix(name: str) -> str:
     if not isinstance(name, str) or not _IDENT.match(name) or len(name) > 48:
         raise ValueError(
             f"prefix: expected a C identifier (letters, digits, _; not starting with a digit; at most "
-            f"48 characters), got {shorten(repr(name))}"
+            f"48 characters), got {V.shorten(repr(name))}"
         )
     if name in _C_KEYWORDS or keyword.iskeyword(name) or name.startswith("apair"):
         raise ValueError(f"prefix: {name!r} is a C, C++ or Python keyword or apair's own prefix")
@@ -177,6 +177,29 @@ def _describe(chain: ChainLike) -> tuple[str, str]:
     return joints, ranges
 
 
+def _ascii(text: str, keep: str, fill: str) -> str:
+    """text for the comments and strings of the generated C, CMake and Python: ASCII letters,
+    digits, _ and the characters of `keep` as they are, any other ASCII character as `fill` (so
+    nothing ends a comment, forms a trigraph or a line splice, or is read by CMake), and a
+    character beyond ASCII as <U+XXXX> (no compiler sees it, and none is lost)."""
+
+    def one(m: re.Match[str]) -> str:
+        ch = m.group()
+        return fill if ch.isascii() else f"<U+{ord(ch):04X}>"
+
+    return re.sub(f"[^A-Za-z0-9_{re.escape(keep)}]", one, text)
+
+
+def _title(title: str | None, n: int) -> str:
+    """The chain's title as the generated files print it: one line of at most 80 characters,
+    `_ascii` (no code point cut in two); the chain's size if it has none or nothing printable."""
+    default = f"{n}-joint chain"
+    if title is None:
+        return default
+    short = " ".join(_ascii(V.text("title", title), " .,:()+-", " ").split())[:80]
+    return re.sub(r"<U\+[0-9A-F]*$", "", short).rstrip() or default
+
+
 def render(
     chain: ChainLike,
     name: str,
@@ -194,9 +217,9 @@ def render(
     tests = references(chain, lowered_kernels)
     by_name = {k.name: k for k in lowered_kernels}
     joints, ranges = _describe(chain)
-    # the title goes into C comments, CMake and pkg-config strings: plain characters only
-    title = " ".join(re.sub(r"[^\w .,:()+-]", " ", title or f"{chain.n}-joint chain").split())[:80]
-    origin = re.sub(r"[^\w .,:+/-]", "_", origin)[:120]
+    # the title and origin go into C comments, CMake strings and Python: `_ascii`
+    title = _title(title, chain.n)
+    origin = _ascii(origin, " .,:+/-", "_")[:120]
     meta = {
         "title": title,
         "origin": origin,

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from html import escape
 from importlib import resources
 from pathlib import Path
@@ -50,6 +51,14 @@ def _clearance_table(pair: PairLike, lo: float, hi: float) -> dict[str, Any]:
     }
 
 
+def _name(chain: ChainLike) -> str:
+    """The chain's name for the page, checked as a text field (docs/conventions.md)."""
+    name = getattr(chain, "name", None)
+    if name is None:
+        return "apair chain"
+    return V.text("chain.name", name) or "apair chain"
+
+
 def chain_data(chain: ChainLike, workspace: int = 0, seed: int = 0) -> dict[str, Any]:
     """What the page needs of the chain: its joints (law kernel and parameters, DH row, range),
     the A-pairs' radii and clearance tables, and optionally `workspace` sampled end points."""
@@ -73,25 +82,32 @@ def chain_data(chain: ChainLike, workspace: int = 0, seed: int = 0) -> dict[str,
             j["leg_radius"] = float(p.leg_radius)
             j["clearance"] = _clearance_table(p, lo, hi)
         joints.append(j)
-    data: dict[str, Any] = {"name": getattr(chain, "name", None) or "apair chain", "n": chain.n, "joints": joints}
+    data: dict[str, Any] = {"name": _name(chain), "n": chain.n, "joints": joints}
     if workspace:
         rng = np.random.default_rng(seed)
         q = rng.uniform([j["lower"] for j in joints], [j["upper"] for j in joints], (workspace, chain.n))
-        data["workspace"] = np.round(chain.fk(q)[:, :3, 3], 6).ravel().tolist()
+        # 7 significant digits each (a page of a reasonable size at any scale: rounding to a fixed
+        # number of decimals would put a micrometre chain's points all at 0)
+        data["workspace"] = np.char.mod("%.7g", chain.fk(q)[:, :3, 3].ravel()).astype(float).tolist()
     return data
+
+
+def _script_json(data: dict[str, Any]) -> str:
+    """data as JSON that a <script> element holds intact: ASCII only (so U+2028 and U+2029 too are
+    escapes), and no <, > or & (a "</script>" or "<!--" in a name would end or change the
+    script's data); in JSON they can occur only inside strings, where the escapes mean the same."""
+    text = json.dumps(data, separators=(",", ":"), ensure_ascii=True)
+    return text.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
 
 
 def to_html(chain: ChainLike, workspace: int = 0) -> str:
     """The viewer page of the chain (see the module's docstring)."""
     workspace = V.integer("workspace", workspace, minimum=0, maximum=MAX_WORKSPACE_POINTS)
-    data = json.dumps(chain_data(chain, workspace), separators=(",", ":"))
-    page = _page_template()
-    title = getattr(chain, "name", None) or "apair chain"
-    return (
-        page.replace("/*APAIR_KERNELS*/", _kernels_js())
-        .replace("/*APAIR_CHAIN*/null", data.replace("</", "<\\/"))
-        .replace("APAIR_TITLE", escape(title))
-    )
+    title = _name(chain)
+    data = _script_json(chain_data(chain, workspace))
+    parts = {"/*APAIR_KERNELS*/": _kernels_js(), "/*APAIR_CHAIN*/null": data, "APAIR_TITLE": escape(title)}
+    # one pass over the template: what goes in (a name holding "APAIR_TITLE") is never replaced again
+    return re.sub("|".join(map(re.escape, parts)), lambda m: parts[m.group()], _page_template())
 
 
 def write(chain: ChainLike, path: str | os.PathLike[str], overwrite: bool = False, workspace: int = 0) -> Path:

@@ -1,18 +1,20 @@
-"""apair view: the page in a real headless browser (Debian's Chromium, driven by Playwright)."""
+"""apair view: the page in a real headless browser (a Chromium driven by Playwright: $CHROMIUM, the
+system's or Playwright's own, as tests/sysdeps.py finds it; `make browser` installs one)."""
 
 import math
-import os
-import shutil
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
+import sysdeps  # tests/sysdeps.py
 
 import apair
 from apair import io, view
 from apair.cli import main
 
 EXAMPLE = "examples/4a_chain.toml"
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 ARGS = [
     "--no-sandbox",
     "--disable-gpu",
@@ -43,11 +45,19 @@ def mixed_chain():
 
 @pytest.fixture(scope="module")
 def browser():
-    sync = pytest.importorskip("playwright.sync_api")
-    if not os.path.exists(CHROMIUM):
-        pytest.fail("Chromium is not installed: `make test` installs it (Debian: apt install chromium)")
-    with sync.sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+    """A headless Chromium: the test fails, never skips, without Playwright or a browser."""
+    try:
+        from playwright import sync_api
+    except ImportError:
+        pytest.fail("Playwright is missing: it is in the test extra (pip install -e '.[test]')")
+    try:
+        found = sysdeps.find_browser()
+    except sysdeps.BrowserError as e:
+        pytest.fail(str(e))
+    if found is None:
+        pytest.fail(sysdeps.missing_browser_message() + "\n(`make browser` does this where it can)")
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=found.path, args=ARGS)
         yield b
         b.close()
 
@@ -125,3 +135,97 @@ def test_cli_view(tmp_path, capsys):
     assert "--workspace" in capsys.readouterr().err
     with pytest.raises(ValueError, match="workspace"):
         view.to_html(io.load(EXAMPLE), workspace=1.5)
+
+
+# ------------------------------------------------------------------ finding the browser (tests/sysdeps.py)
+def fake_browser(folder, name):
+    """An executable that answers --version like a browser, as `name` in folder."""
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / name
+    path.write_text("#!/bin/sh\necho 'Chromium 1.0 (fake)'\n")
+    path.chmod(0o755)
+    return str(path)
+
+
+@pytest.fixture
+def no_browsers(tmp_path, monkeypatch):
+    """No $CHROMIUM, a PATH with no browser on it, and an empty folder for Playwright's browsers."""
+    monkeypatch.delenv("CHROMIUM", raising=False)
+    monkeypatch.setenv("PATH", str(tmp_path / "bin"))
+    monkeypatch.setenv("PLAYWRIGHT_BROWSERS_PATH", str(tmp_path / "pw"))
+    return tmp_path
+
+
+def test_browser_is_found_in_order(no_browsers, monkeypatch):
+    """$CHROMIUM first, then a system browser on PATH, then Playwright's own; none: a message that
+    names the commands that install one, with and without root."""
+    tmp = no_browsers
+    assert sysdeps.find_browser() is None
+    message = sysdeps.missing_browser_message()
+    assert "apt-get install -y --no-install-recommends chromium" in message
+    assert f"{sys.executable} -m playwright install chromium" in message and "CHROMIUM=" in message
+    # Playwright's own, where `python -m playwright install chromium` puts it
+    own = sysdeps.playwright_executable()
+    assert own is not None and own.startswith(str(tmp / "pw"))
+    fake_browser(Path(own).parent, Path(own).name)
+    assert sysdeps.find_browser() == sysdeps.Browser(own, "playwright")
+    # a system browser comes before it, under any of the usual names
+    system = fake_browser(tmp / "bin", "chromium-browser")
+    assert sysdeps.find_browser() == sysdeps.Browser(system, "system")
+    # and $CHROMIUM before both, by path or by name on PATH
+    chosen = fake_browser(tmp / "mine", "chrome-canary")
+    monkeypatch.setenv("CHROMIUM", chosen)
+    assert sysdeps.find_browser() == sysdeps.Browser(chosen, "$CHROMIUM")
+    monkeypatch.setenv("CHROMIUM", "chromium-browser")
+    assert sysdeps.find_browser() == sysdeps.Browser(system, "$CHROMIUM")
+    # a $CHROMIUM that names nothing that runs is an error, not passed over
+    for bad in (str(tmp / "missing"), "no-such-browser"):
+        monkeypatch.setenv("CHROMIUM", bad)
+        with pytest.raises(sysdeps.BrowserError, match="CHROMIUM="):
+            sysdeps.find_browser()
+    broken = tmp / "bin" / "chromium"
+    broken.write_text("#!/bin/sh\nexit 1\n")  # e.g. a stub that names a missing snap
+    broken.chmod(0o755)
+    monkeypatch.delenv("CHROMIUM")
+    assert sysdeps.find_browser() == sysdeps.Browser(system, "system")
+
+
+def test_make_browser_installs_or_stops_with_the_commands(no_browsers, monkeypatch, capsys):
+    """`make browser` without a browser: Debian's package where root or sudo allows, else
+    Playwright's download; when neither brings one it exits 1 naming the commands."""
+    tried = []
+    monkeypatch.setattr(sysdeps, "apt_install", lambda packages: tried.append(("apt", packages)) or False)
+    monkeypatch.setattr(sysdeps, "playwright_install", lambda: tried.append(("playwright",)) or False)
+    assert sysdeps.main(["browser"]) == 1
+    assert tried == [("apt", ("chromium",)), ("playwright",)]
+    err = capsys.readouterr().err
+    assert "no Chromium for the browser test" in err and "playwright install chromium" in err
+
+    # the first way that brings a browser ends the search
+    def apt(packages):
+        fake_browser(no_browsers / "bin", "chromium")
+        return True
+
+    monkeypatch.setattr(sysdeps, "apt_install", apt)
+    assert sysdeps.main(["browser"]) == 0
+    assert "(system)" in capsys.readouterr().out
+
+
+def test_make_browser_as_a_user_without_root_or_sudo(no_browsers, monkeypatch):
+    """Without root or a password-less sudo apt-get is not tried (no password prompt either)."""
+    monkeypatch.setattr(sysdeps.os, "geteuid", lambda: 1000)
+    fake_browser(no_browsers / "bin", "apt-get")
+    sudo = no_browsers / "bin" / "sudo"
+    sudo.write_text("#!/bin/sh\nexit 1\n")  # sudo -n: a password would be needed
+    sudo.chmod(0o755)
+    assert sysdeps.root_prefix() is None and sysdeps.apt_install(("chromium",)) is False
+    sudo.write_text("#!/bin/sh\nexit 0\n")
+    assert sysdeps.root_prefix() == [str(sudo), "-n"]
+
+
+def test_sysdeps_script_runs_from_the_makefile():
+    """The Makefile's browser target runs the script with the venv's python from the root."""
+    root = Path(__file__).resolve().parents[2]
+    assert "\t@$(PY) tests/sysdeps.py browser" in (root / "Makefile").read_text()
+    res = subprocess.run([sys.executable, "tests/sysdeps.py", "nothing"], capture_output=True, text=True, cwd=root)
+    assert res.returncode == 2 and "usage" in res.stderr

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -19,6 +20,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
+import sysdeps  # tests/sysdeps.py: clang, and the packages that bring it
 
 ROOT = Path(__file__).resolve().parents[2]
 CDIR = ROOT / "generated" / "c"
@@ -183,6 +185,19 @@ SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=1", "UBSAN_OPTIONS": "
 EXAMPLE = ROOT / "examples" / "c" / "chain_4a.c"
 
 
+def test_clang_skip_messages_and_the_readme_name_the_same_packages():
+    """Where clang is missing the clang configurations are skipped with the command that installs
+    it, and the README's set-up names that command: the same Debian packages that `make clang`
+    (tests/sysdeps.py) installs."""
+    command = sysdeps.apt_command(sysdeps.CLANG_PACKAGES)
+    assert "clang" in sysdeps.CLANG_PACKAGES and "libclang-rt-dev" in sysdeps.CLANG_PACKAGES  # ASan, UBSan
+    assert command in sysdeps.clang_skip_reason("clang is not installed")
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    assert f"`{command}`" in readme
+    makefile = (ROOT / "Makefile").read_text()
+    assert re.search(r"^test: .*\bclang\b", makefile, re.M), "make test does not install clang"
+
+
 def tool(name: str) -> str | None:
     """A build tool from the environment's own bin folder (the test extra installs cmake and
     pkgconf there), else from PATH."""
@@ -250,10 +265,14 @@ def check_example(exe, env=None) -> None:
 def test_library_driver_and_example_across_compilers(compiler, lang, opt, sanitize, driver, tmp_path):
     """Every kernel single, batched and through the registry (the driver), and the example
     program against the Python runtime, for one compiler configuration."""
+    clang = compiler.startswith("clang")
     if shutil.which(compiler) is None:
-        pytest.skip(f"{compiler} is not installed (Debian/Ubuntu: apt install clang)")
+        pytest.skip(
+            sysdeps.clang_skip_reason(f"{compiler} is not installed") if clang else f"{compiler} is not installed"
+        )
     if sanitize and not sanitizers_link(compiler, tmp_path):
-        pytest.skip(f"{compiler} has no sanitizer runtime here (Debian/Ubuntu: apt install libclang-rt-dev)")
+        why = f"{compiler} has no sanitizer runtime"
+        pytest.skip(sysdeps.clang_skip_reason(why) if clang else why)
     exes = build(compiler, lang, opt, sanitize, [driver, EXAMPLE], tmp_path)
     env = SAN_ENV if sanitize else None
     res = run([str(exes["driver"])], env=env)
@@ -324,6 +343,71 @@ def test_cmake_install_serves_find_package_and_pkg_config(cmake, tmp_path):
     env = dict(os.environ, PKG_CONFIG_PATH=os.pathsep.join(str(p.parent) for p in moved.rglob("apair.pc")))
     flags = run([pkg_config, "--cflags", "--libs", "apair"], env=env).stdout.split()
     assert any(f.startswith("-I") and Path(f[2:]).resolve() == (moved / "include").resolve() for f in flags), flags
+
+
+# A parent project of apair codegen's CMakeLists (examples/codegen/chain4a, by add_subdirectory):
+# its top-level lines after project(), its cache options, and how many tests ctest finds in the
+# parent's build folder. "own": the chain's folder built on its own, no parent.
+CHAIN_CODE = ROOT / "examples" / "codegen" / "chain4a"
+PARENTS = {
+    "own": (None, [], 1),
+    "enable_testing": ("enable_testing()\nadd_subdirectory(chain4a)\n", [], 1),
+    "include_ctest": ("include(CTest)\nadd_subdirectory(chain4a)\n", [], 1),
+    "enable_testing_after": ("add_subdirectory(chain4a)\nenable_testing()\n", [], 1),
+    "testing_off": ("include(CTest)\nadd_subdirectory(chain4a)\n", ["-DBUILD_TESTING=OFF"], 0),
+    "no_testing": ("add_subdirectory(chain4a)\n", [], 0),
+}
+
+
+def test_readme_names_every_file_apair_codegen_writes():
+    """The README's paragraph on `apair codegen ... --prefix arm4` names each file that apair
+    codegen writes: those of examples/codegen/chain4a (the example chain's, --prefix chain4a, which
+    make check compares with a fresh run)."""
+    readme = (ROOT / "README.md").read_text()
+    paragraph = re.search(r"^`apair codegen .*?(?:\n\n|\Z)", readme, re.M | re.S).group(0)
+    written = sorted(p.name.replace("chain4a", "arm4") for p in CHAIN_CODE.iterdir())
+    assert "manifest.json" in written and len(written) == 7
+    assert [f for f in written if f"`{f}`" not in paragraph] == []
+
+
+def ctest_count(ctest: str, folder: Path) -> int:
+    out = run([ctest, "-N"], cwd=folder).stdout
+    return int(out.rsplit("Total Tests:", 1)[1].split()[0])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("parent", PARENTS)
+def test_chain_code_self_test_runs_under_ctest(cmake, parent, tmp_path):
+    """apair codegen's CMakeLists: ctest runs the chain's self-test from its own build folder, and
+    from a parent's under add_subdirectory when the parent enables testing (before or after
+    add_subdirectory, by enable_testing() or include(CTest)), never with BUILD_TESTING=OFF. Under
+    add_subdirectory the chain leaves CTest's dashboard set-up (include(CTest): DartConfiguration.tcl,
+    the Experimental targets) to the parent, and its header says what the parent must call."""
+    ctest = tool("ctest")
+    if ctest is None:
+        pytest.fail("ctest is missing: the cmake package of the test extra has it (pip install .[test])")
+    header = (CHAIN_CODE / "CMakeLists.txt").read_text().split("cmake_minimum_required")[0]
+    assert "enable_testing() or include(CTest)" in " ".join(header.replace("#", " ").split())
+    lines, options, count = PARENTS[parent]
+    if lines is None:
+        src, sub = CHAIN_CODE, None
+    else:
+        src = tmp_path / "parent"
+        shutil.copytree(CHAIN_CODE, src / "chain4a")
+        (src / "CMakeLists.txt").write_text(
+            "cmake_minimum_required(VERSION 3.13)\nproject(parent LANGUAGES C)\n" + lines
+        )
+        sub = "chain4a"
+    build = tmp_path / "build"
+    run([cmake, "-S", str(src), "-B", str(build), *options])
+    run([cmake, "--build", str(build), "--parallel", "2"])
+    assert ctest_count(ctest, build) == count
+    if count:
+        assert "100% tests passed" in run([ctest, "--output-on-failure"], cwd=build).stdout
+    if sub is not None:
+        assert not (build / sub / "DartConfiguration.tcl").exists()
+        # in the chain's own build folder the test is there whenever testing is not switched off
+        assert ctest_count(ctest, build / sub) == (0 if "-DBUILD_TESTING=OFF" in options else 1)
 
 
 @pytest.mark.slow

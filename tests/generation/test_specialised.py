@@ -381,7 +381,7 @@ def test_bad_inputs_are_refused_on_every_path(cache, specialised):
         ("qd", lambda: chain.bias(ok, np.array([np.nan] * n)), "NaN"),
         ("qdd", lambda: chain.inverse_dynamics(ok, ok, np.zeros((2, n + 1))), "shape"),
         ("qd", lambda: chain.energy(np.zeros((3, n)), np.zeros((2, n))), "batch shape"),
-        ("q[..., 0]", lambda: chain.fk(np.array([lim + 0.1] + [0.0] * (n - 1))), "outside this pair's range"),
+        ("q[..., 0] (joint 1)", lambda: chain.fk(np.array([lim + 0.1] + [0.0] * (n - 1))), "outside this pair's range"),
         ("q", lambda: chain.mass_matrix(np.array([lim] + [0.0] * (n - 1))), "limit"),
     ]
     for name, fn, what in cases:

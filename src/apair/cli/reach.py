@@ -17,29 +17,30 @@ from .output import add_json, emit, text_numbers
 
 if TYPE_CHECKING:
     from ..ik import Solution
+    from ..ik.local import Nearest
 
 Sub = Any  # argparse's subparsers action (a private class)
 
 
 def _cmd_ik(args: argparse.Namespace) -> int:
-    from ..ik import distance
+    from ..ik.local import nearest as nearest_pose
 
     chain = load(args.file)
     T = A.pose(args.pose)
     with A.named({"T": "POSE"}, joints={"pairs": args.file}):
         sol = chain.ik(T, full=True)
-        nearest = None if len(sol.q) else distance(chain, T)
+        nearest = None if len(sol.q) else nearest_pose(chain, T)
     inside = cast(NDArray[np.bool_], sol.inside)  # set by full=True
     if args.json:
         emit(_ik_document(args, chain.name, sol, inside, nearest))
         return 0 if nearest is None else 1
     with text_numbers():
         if nearest is not None:
-            dp, dr, q = nearest
             why = "" if sol.certified else " (not certified complete)"
             print(
                 f"{chain.name}: the pose is unreachable{why}. The nearest pose found inside the joint limits "
-                f"(q = {q} rad) is {dp:.3e} m and {dr:.3e} rad away."
+                f"(q = {nearest.q} rad) is {nearest.position:.3e} m and {nearest.rotation:.3e} rad away "
+                f"(distance {nearest.distance:.3e}, one radian weighing as {nearest.scale:.3g} m)."
             )
             return 1
         complete = "" if sol.certified else "; not certified complete"
@@ -59,7 +60,7 @@ def _ik_document(
     name: str,
     sol: Solution,
     inside: NDArray[np.bool_],
-    nearest: tuple[float, float, NDArray[np.float64]] | None,
+    nearest: Nearest | None,
 ) -> dict[str, Any]:
     """`apair ik --json`: the solutions (q_deg too with --deg), or the nearest pose found."""
     solutions = []
@@ -78,8 +79,13 @@ def _ik_document(
         "certified": sol.certified,
     }
     if nearest is not None:
-        dp, dr, q = nearest
-        doc["nearest"] = {"q": q, "distance_m": dp, "distance_rad": dr}
+        doc["nearest"] = {
+            "q": nearest.q,
+            "distance_m": nearest.position,
+            "distance_rad": nearest.rotation,
+            "distance": nearest.distance,
+            "length_scale_m": nearest.scale,
+        }
     return doc
 
 
