@@ -26,6 +26,7 @@ from .pair import APair
 from .study import normalise
 
 if TYPE_CHECKING:
+    from .compare import Comparison
     from .ik import LocalSolution, Solution, Solver
     from .ik.homotopy import StartSystem
     from .kernels import FastPath
@@ -542,6 +543,25 @@ class AChain:
             seed=V.seed(seed),
             progress=progress,
         )
+
+    def compare(
+        self,
+        twin: str | None = None,
+        samples: int = 300_000,
+        seed: int = 0,
+        path: ArrayLike | None = None,
+        engine: object = None,
+        progress: Callable[[str], object] | None = None,
+    ) -> Comparison:
+        """This chain beside its twin (apair.compare): every A-pair an R-pair (twin=None: "revolute")
+        at the same DH constants and links, measured on the same work: workspaces, joint ranges,
+        dexterity, gravity and path torques, mass, ik counts. samples, seed, engine: the workspaces'
+        (the chain's volume is workspace(samples=samples, seed=seed)'s); path: points (k, 3) [m] of
+        the common end-effector path (default: a straight line through both workspaces). Returns
+        `apair.compare.Comparison` (.table(), .as_dict(), .report(path), .picture(path))."""
+        from .compare import compare
+
+        return compare(self, twin=twin, samples=samples, seed=seed, path=path, engine=engine, progress=progress)
 
     def within_limits(self, q: ArrayLike) -> NDArray[np.bool_]:
         """(...): whether each joint vector lies inside `limits` (bounds included)."""

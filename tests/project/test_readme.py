@@ -21,9 +21,10 @@ def test_readme_is_a_front_page():
     first = re.search(r"^(?: {4}.*\n)+", text, re.M).group(0)
     assert [line.split("#")[0].strip() for line in first.splitlines()] == ["make", "make test"]
     assert text.index(first) < text.index("```")
-    # one picture, which exists
+    # two pictures (the viewer, the comparison with the R twin), which exist
     pictures = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", text)
-    assert len(pictures) == 1 and (ROOT / pictures[0]).is_file()
+    assert len(pictures) <= 2 and all((ROOT / p).is_file() for p in pictures)
+    assert "docs/images/compare.png" in pictures
 
 
 def test_readme_links_resolve():

@@ -9,7 +9,7 @@ import sys
 from collections.abc import Sequence
 
 from .._version import __version__
-from . import exports, info, motion, reach
+from . import compare, exports, info, motion, reach
 from .args import NEGATIVE_NUMBER
 from .output import one_line
 
@@ -25,6 +25,7 @@ COMMANDS = (
     reach.add_ik_prepare,
     motion.add_limits,
     reach.add_workspace,
+    compare.add_compare,
     exports.add_codegen,
     exports.add_export,
     exports.add_view,

@@ -57,7 +57,7 @@ def _cmd_ik(args: argparse.Namespace) -> int:
 
 def _ik_document(
     args: argparse.Namespace,
-    name: str,
+    name: str | None,
     sol: Solution,
     inside: NDArray[np.bool_],
     nearest: Nearest | None,
