@@ -6,19 +6,22 @@ The closed forms are derived symbolically (derivations/), emitted as C and NumPy
 
 from . import plots, polynomials  # plots imports matplotlib only when a picture is drawn
 from ._version import __version__
-from .chain import AChain
+from .chain import AChain, frame
 from .io import load
 from .kernels import backend, c_available, set_backend
 from .link import Link
 from .pair import APair
 from .simulate import Trajectory
+from .urdf import load_urdf
 
 __all__ = [
     "APair",
     "AChain",
     "Link",
     "Trajectory",
+    "frame",
     "load",
+    "load_urdf",
     "plots",
     "polynomials",
     "set_backend",

@@ -9,6 +9,7 @@ otherwise the validating path checks and converts them first. Batches stay in th
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import os
@@ -23,7 +24,7 @@ from .files import write_text
 from .kernels import call, native_chain
 from .link import Link
 from .pair import APair
-from .study import normalise
+from .study import from_matrix, multiply, normalise
 
 if TYPE_CHECKING:
     from .compare import Comparison
@@ -52,12 +53,79 @@ METHODS = (
 )
 
 
+FRAME_TOL = 1e-9  # a base or tool rotation is orthonormal to this (largest entry of |RᵀR − I|)
+_EYE4 = np.eye(4)
+_EYE4.flags.writeable = False
+
+
+def rpy_matrix(rpy: ArrayLike) -> NDArray[np.float64]:
+    """(3, 3): URDF's fixed-axis roll-pitch-yaw rotation Rz(yaw)·Ry(pitch)·Rx(roll) [rad]."""
+    r, p, y = np.asarray(rpy, float)
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def frame(xyz: ArrayLike = (0.0, 0.0, 0.0), rpy: ArrayLike = (0.0, 0.0, 0.0)) -> NDArray[np.float64]:
+    """(4, 4): the rigid transform of a translation xyz [m] and a URDF roll-pitch-yaw rpy [rad]
+    (`rpy_matrix`), as a chain's `base` or `tool`."""
+    T = np.eye(4)
+    T[:3, :3] = rpy_matrix(V.vector("rpy", rpy, 3))
+    T[:3, 3] = V.vector("xyz", xyz, 3)
+    return T
+
+
+def check_frame(name: str, value: object) -> NDArray[np.float64] | None:
+    """A base or tool transform, validated: (4, 4), finite, the rotation orthonormal to FRAME_TOL
+    with det +1, last row exactly [0, 0, 0, 1], the translation within the length range apair
+    computes in. Returns a read-only float64 copy, or None for None or the identity exactly (no
+    frame: the methods skip the composition)."""
+    if value is None:
+        return None
+    T = np.array(V.real_array(name, value), dtype=np.float64)
+    if T.shape != (4, 4):
+        raise ValueError(f"{name}: expected a 4x4 rigid transform, got shape {T.shape}")
+    if not np.array_equal(T[3], [0.0, 0.0, 0.0, 1.0]):
+        raise ValueError(f"{name}: last row must be [0, 0, 0, 1], got {T[3].tolist()}")
+    R = T[:3, :3]
+    err = float(np.abs(R.T @ R - np.eye(3)).max())
+    if err > FRAME_TOL:
+        raise ValueError(f"{name}: the rotation part is not orthonormal (|RᵀR − I| = {err:.3g} > {FRAME_TOL:g})")
+    if np.linalg.det(R) < 0:
+        raise ValueError(f"{name}: the rotation part is a reflection (det −1), not a rotation")
+    V.in_range(f"{name} translation", T[:3, 3], "m")
+    if np.array_equal(T, _EYE4):
+        return None
+    T.flags.writeable = False
+    return T
+
+
+def _inverse(T: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The inverse of a rigid transform."""
+    out = np.eye(4)
+    out[:3, :3] = T[:3, :3].T
+    out[:3, 3] = -(T[:3, :3].T @ T[:3, 3])
+    return out
+
+
 class AChain:
     """A chain of `pairs` with DH constants a (link lengths), alpha (twists), offset (c),
     theta_offset (φ). Angles in radians, lengths in metres. `limits`: per joint an explicit range
-    (lo, hi) or None for the pair's own (see `limits`)."""
+    (lo, hi) or None for the pair's own (see `limits`). `base`, `tool`: 4×4 rigid transforms (None:
+    the identity) of the DH frame 0 in the world and of the tool in frame n (docs/conventions.md,
+    "Base and tool frames"): fk, fk_study, the Jacobian, ik and ik_local are of the tool in the
+    world, `gravity` is in the world."""
 
     _name: str | None = None
+    # base and tool frames: None for the identity; _framed whether either is not
+    _base_T: NDArray[np.float64] | None = None
+    _tool_T: NDArray[np.float64] | None = None
+    _framed: bool = False
 
     @property
     def name(self) -> str | None:
@@ -81,6 +149,8 @@ class AChain:
         links: Iterable[Link] | None = None,
         gravity: ArrayLike = (0.0, 0.0, -9.81),
         limits: Iterable[ArrayLike | None] | None = None,
+        base: ArrayLike | None = None,
+        tool: ArrayLike | None = None,
     ) -> None:
         try:
             pair_list = list(pairs)
@@ -116,7 +186,13 @@ class AChain:
         V.in_range("gravity", self.gravity, "m/s^2")
         self._links = np.ascontiguousarray(np.stack([link.as_row() for link in links]))
         self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pair_list])
-        self._gravity = np.ascontiguousarray(self.gravity)
+        self._base_T, self._tool_T = check_frame("base", base), check_frame("tool", tool)
+        self._framed = self._base_T is not None or self._tool_T is not None
+        # the kernels' gravity is in the DH base frame (frame 0): Rbᵀ·g
+        g0 = self.gravity if self._base_T is None else self._base_T[:3, :3].T @ self.gravity
+        self._gravity = np.ascontiguousarray(g0)
+        if self._framed:
+            self._set_frames()
         self._law_groups = self._group_laws()
         self._ranged = [i for i, p in enumerate(pair_list) if p.theta_limit is not None]  # angles to check
         self._ik: Solver | None = None  # the inverse-kinematics solver, built on the first call of ik()
@@ -125,13 +201,78 @@ class AChain:
 
     def _use(self, fast: FastPath) -> None:
         """Take `fast` (kernels.native_chain) as the methods' fast path; its bound call is kept,
-        since an attribute lookup less is measurable at single calls."""
-        self._fast, self._call = fast, fast.call
+        since an attribute lookup less is measurable at single calls. With base or tool frames,
+        the call goes through `_framed_call`, which composes them with fk, fk_study, jacobian."""
+        self._fast = fast
+        self._call = self._framed_call if self._framed else fast.call
+
+    # ----------------------------------------------------------------------------- base and tool
+    @property
+    def base(self) -> NDArray[np.float64]:
+        """(4, 4): the pose of the DH frame 0 in the world (a copy; the identity if none)."""
+        return np.eye(4) if self._base_T is None else self._base_T.copy()
+
+    @property
+    def tool(self) -> NDArray[np.float64]:
+        """(4, 4): the pose of the tool in the DH frame n (a copy; the identity if none)."""
+        return np.eye(4) if self._tool_T is None else self._tool_T.copy()
+
+    def _set_frames(self) -> None:
+        """The frames' derived constants: the transforms (identity for none), their Study points
+        and inverses, the tool's offset (None if zero)."""
+        B = _EYE4 if self._base_T is None else self._base_T
+        T = _EYE4 if self._tool_T is None else self._tool_T
+        self._B, self._T = B, T
+        self._B_study, self._T_study = from_matrix(B), from_matrix(T)
+        self._B_inv, self._T_inv = _inverse(B), _inverse(T)
+        self._tool_offset = None if not T[:3, 3].any() else T[:3, 3].copy()
+
+    def _framed_call(self, method: int, *args: Any) -> NDArray[np.float64] | None:
+        """The fast path of a chain with frames: the kernels' result, composed (`_compose`)."""
+        out: NDArray[np.float64] | None = self._fast.call(method, *args)
+        if out is None or method > 2:
+            return out
+        return self._compose(method, out, args[0])
+
+    def _compose(self, method: int, out: NDArray[np.float64], q: Any) -> NDArray[np.float64]:
+        """fk (0), fk_study (1) or jacobian (2) of the DH chain at q, made the tool's in the world:
+        base · fk · tool; the Study points' product; the Jacobian of the tool's origin (v + ω × r,
+        r = R_n · tool offset), both row blocks rotated by the base."""
+        if method == 0:
+            return self._B @ out @ self._T
+        if method == 1:
+            return multiply(multiply(self._B_study, out), self._T_study)
+        Jv, Jw = out[..., :3, :], out[..., 3:, :]
+        if self._tool_offset is not None:
+            F = self._fast.call(0, q)
+            if F is None:
+                F = self._evaluate(0, "fk", q, (self._dh,), strict=False, framed=False)
+            r = F[..., :3, :3] @ self._tool_offset
+            Jv = Jv + np.cross(Jw, r[..., :, None], axis=-2)  # v + ω × r, column by column
+        Rb = self._B[:3, :3]
+        return np.concatenate([Rb @ Jv, Rb @ Jw], axis=-2)
+
+    def _dh_chain(self) -> AChain:
+        """This chain without its frames, gravity in frame 0 (the same dynamics): the chain that
+        ik and ik_local solve for T_dh = base⁻¹ · T · tool⁻¹ (the joint values are the same)."""
+        if not self._framed:
+            return self
+        plain = copy.copy(self)
+        plain.__dict__.update(_base_T=None, _tool_T=None, _framed=False, _ik=None, _local_ik=None)
+        plain.gravity = self._gravity.copy()
+        plain._use(self._fast)
+        return plain
+
+    def _to_dh(self, T: NDArray[np.float64]) -> NDArray[np.float64]:
+        """World poses of the tool (..., 4, 4) → poses of frame n in frame 0: base⁻¹ · T · tool⁻¹."""
+        out: NDArray[np.float64] = self._B_inv @ T @ self._T_inv
+        return out
 
     def __getstate__(self) -> dict[str, Any]:
         state = dict(self.__dict__)
         del state["_fast"], state["_call"]  # native objects: rebuilt on unpickling
         state.pop("_local_ik", None)  # ik_local's, set up again by its first call
+        state.pop("_ik", None)  # the ik solver (it may hold the frameless chain): built again
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -186,10 +327,13 @@ class AChain:
         return len(self.pairs)
 
     def __repr__(self) -> str:
+        frames = "".join(
+            f", {key}={T.tolist()}" for key, T in (("base", self._base_T), ("tool", self._tool_T)) if T is not None
+        )
         return (
             f"AChain({self.pairs!r}, a={self.a.tolist()}, alpha={self.alpha.tolist()}, "
             f"offset={self.offset.tolist()}, theta_offset={self.theta_offset.tolist()}, "
-            f"links={self.links!r}, gravity={self.gravity.tolist()})"
+            f"links={self.links!r}, gravity={self.gravity.tolist()}{frames})"
         )
 
     def _q(self, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
@@ -266,32 +410,39 @@ class AChain:
         q: ArrayLike,
         design: Sequence[NDArray[np.float64]],
         strict: bool = True,
+        framed: bool = True,
         **named: ArrayLike,
     ) -> NDArray[np.float64]:
         """The validating path of a method: checks and converts the inputs (a ValueError names
         the argument), then the fast path again, else the law kernels and the generic kernel of
-        `family` with the `design` inputs after the state."""
+        `family` with the `design` inputs after the state; with `framed`, the base and tool frames
+        composed (`_compose`)."""
         arrays = self._state(q, strict, **named)
-        out = self._call(method, *arrays)
+        out = self._fast.call(method, *arrays)
         if out is None:
             law = self._law(arrays[0])
             if strict and not np.isfinite(law).all():
                 raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
             out = call(f"{family}{self.n}", law, *arrays[1:], *design)[0]
+        if framed and self._framed and method <= 2:
+            out = self._compose(method, out, arrays[0])
         return out
 
     def fk(self, q: ArrayLike) -> NDArray[np.float64]:
-        """(..., 4, 4): the pose of frame n in the base frame; q is (n,) or (..., n)."""
+        """(..., 4, 4): the pose of the tool in the world, base · (frame n in frame 0) · tool; q is
+        (n,) or (..., n)."""
         out = self._call(0, q)
         return out if out is not None else self._evaluate(0, "fk", q, (self._dh,), strict=False)
 
     def fk_study(self, q: ArrayLike) -> NDArray[np.float64]:
-        """(..., 8): the Study point (x0..x3, y0..y3) of fk(q), with |x| = 1; (x, y) ~ (−x, −y)."""
+        """(..., 8): the Study point (x0..x3, y0..y3) of fk(q) (the tool in the world), with |x| = 1;
+        (x, y) ~ (−x, −y)."""
         out = self._call(1, q)
         return normalise(out if out is not None else self._evaluate(1, "fk_study", q, (self._dh,), strict=False))
 
     def jacobian(self, q: ArrayLike) -> NDArray[np.float64]:
-        """(..., 6, n): geometric Jacobian, base frame, rows [v; ω] (v of the origin of frame n)."""
+        """(..., 6, n): geometric Jacobian in the world frame, rows [v; ω] (v of the tool's origin;
+        without base and tool frames, of frame n's origin in frame 0)."""
         out = self._call(2, q)
         return out if out is not None else self._evaluate(2, "jacobian", q, (self._dh,))
 
@@ -334,7 +485,8 @@ class AChain:
         return out
 
     def energy(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
-        """(..., 2): kinetic and potential energy (T, V) [J], legs included."""
+        """(..., 2): kinetic and potential energy (T, V) [J], legs included; V of gravity (in the
+        world) is zero with every body at the origin of frame 0."""
         out = self._call(9, q, qd)
         return out if out is not None else self._evaluate(9, "energy", q, self._body, qd=qd)
 
@@ -348,7 +500,11 @@ class AChain:
         the same methods, faster. `kernels`: a subset of fk, fk_study, jacobian, mass_matrix,
         coriolis, gravity_torques, bias, inverse_dynamics, forward_dynamics, energy (default: all;
         the others stay generic). Without a C compiler it warns once and uses the generic kernels
-        (`.specialised` says which)."""
+        (`.specialised` says which). A chain with base or tool frames is refused (not yet in the
+        generated code)."""
+        from .specialise import check_frames
+
+        check_frames(self)
         return SpecialisedChain(self, kernels)
 
     def to_mjcf(
@@ -444,7 +600,9 @@ class AChain:
         self, T: ArrayLike, tol: float = 1e-9, full: bool = False, within_limits: bool = False
     ) -> NDArray[np.float64] | Solution:
         """All real joint vectors q (k, n) with fk(q) = T, each verified (largest entry of
-        |fk(q) − T| ≤ tol); (0, n) when T is out of reach. T: a 4×4 transform or a Study point.
+        |fk(q) − T| ≤ tol); (0, n) when T is out of reach. T: a 4×4 transform or a Study point,
+        the tool's pose in the world (with base or tool frames: solved for frame n's pose
+        base⁻¹·T·tool⁻¹ in frame 0, where the check and `error` are measured).
         within_limits=True keeps only the solutions inside `limits` (no collisions).
 
         Chains of 1 to 6 sinusoidal A-pairs or R-pairs. n ≤ 4 by kinematic mapping (see
@@ -465,7 +623,14 @@ class AChain:
         tol = V.scalar("tol", tol, positive=True)
         full, within_limits = V.flag("full", full), V.flag("within_limits", within_limits)
         if self._ik is None:
-            self._ik = Solver(self)
+            self._ik = Solver(self._dh_chain())
+        if self._framed:
+            from .ik.poses import pose_matrix
+
+            dtype = getattr(T, "dtype", None)
+            T = self._to_dh(pose_matrix(T))
+            if dtype is not None and np.dtype(dtype).kind == "f" and np.dtype(dtype).itemsize < 8:
+                T = T.astype(dtype)  # a rounded pose stays one: the solver's tolerance floor for it
         sol = self._ik.solve(T, tol=tol, count_complex=full)
         if not (full or within_limits):
             return sol.q
@@ -497,7 +662,9 @@ class AChain:
             from .ik.homotopy.trace import certify as trace_test
 
             certify = trace_test
-        return homotopy.start_system(homotopy.Problem.of(self), progress=progress, refresh=refresh, certify=certify)
+        return homotopy.start_system(
+            homotopy.Problem.of(self._dh_chain()), progress=progress, refresh=refresh, certify=certify
+        )
 
     def ik_local(self, T: ArrayLike, q0: ArrayLike, tol: float = 1e-10, max_iter: int = 100) -> LocalSolution:
         """The solution nearest (in the damped least-squares sense) to each seed: Levenberg-Marquardt
@@ -505,16 +672,27 @@ class AChain:
         inside `limits`; in C on the fk and Jacobian kernels. Returns `apair.ik.LocalSolution`
         (q, residual = largest entry of |fk(q) − T|, converged = residual ≤ tol). Any n, any pairs.
         One float64 pose and seed (a controller's call) take one native call once the first call
-        has set the chain's fast path up (apair.ik.local.local_solver); the same numbers."""
+        has set the chain's fast path up (apair.ik.local.local_solver); the same numbers. With base
+        or tool frames T is the tool's pose in the world, solved for base⁻¹·T·tool⁻¹ (the residual
+        is measured there)."""
         if self._local_ik is not None:
             out: LocalSolution | None = self._local_ik.call(T, q0, tol, max_iter)
             if out is not None:
                 return out
         from .ik.local import ik_local, local_solver
 
-        out = ik_local(self, T, q0, tol=tol, max_iter=V.integer("max_iter", max_iter, maximum=MAX_ITER))
+        plain = self._dh_chain()
+        if self._framed:
+            from .ik.poses import check_matrix
+
+            T = V.real_array("T", T)
+            if T.shape[-2:] != (4, 4):
+                raise ValueError(f"T: expected a 4x4 transform or an array of them (..., 4, 4), got shape {T.shape}")
+            T = self._to_dh(check_matrix(T))
+        out = ik_local(plain, T, q0, tol=tol, max_iter=V.integer("max_iter", max_iter, maximum=MAX_ITER))
         if self._local_ik is None:
-            self._local_ik = local_solver(self, MAX_ITER)
+            fast = local_solver(plain, MAX_ITER)
+            self._local_ik = _FramedLocal(fast, self) if self._framed and fast is not None else fast
         return out
 
     def workspace(
@@ -527,7 +705,7 @@ class AChain:
         seed: int = 0,
         progress: Callable[[int, int], object] | None = None,
     ) -> Workspace:
-        """The reachable workspace of the end-effector origin inside `limits` (apair.workspace):
+        """The reachable workspace of the tool's origin (in the world) inside `limits` (apair.workspace):
         `.points`, `.boundary`, `.volume`, `.volume_error` (one standard uncertainty), `.plot(path)`.
         engine: None (this process), "threads"/"processes" (local Dask) or a dask.distributed
         scheduler address or Client; the result does not depend on it."""
@@ -568,6 +746,21 @@ class AChain:
         q = self._q(q)
         lim = self.limits
         return np.all((q >= lim[:, 0]) & (q <= lim[:, 1]), axis=-1)
+
+
+class _FramedLocal:
+    """ik_local's single-pose fast path of a chain with frames: the world pose T made frame n's
+    (base⁻¹·T·tool⁻¹) before the frameless chain's native call; None (the validating path) for
+    any T but a float64 4×4 array."""
+
+    def __init__(self, fast: Any, chain: AChain) -> None:
+        self._inner, self._B_inv, self._T_inv = fast.call, chain._B_inv, chain._T_inv
+
+    def call(self, T: Any, q0: Any, tol: Any, max_iter: Any) -> LocalSolution | None:
+        if type(T) is not np.ndarray or T.dtype != np.float64 or T.shape != (4, 4) or not np.isfinite(T).all():
+            return None
+        out: LocalSolution | None = self._inner(self._B_inv @ T @ self._T_inv, q0, tol, max_iter)
+        return out
 
 
 class SpecialisedChain(AChain):

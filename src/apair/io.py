@@ -17,7 +17,11 @@ mass = 1.0                     # link i (optional): mass [kg], centre of mass in
 com = [0.0, 0.0, 0.05]         # inertia about the centre of mass in frame i [kg m^2]:
 inertia = [0.01, 0.01, 0.02]   # principal (Ixx, Iyy, Izz), six values (Ixx, Iyy, Izz, Ixy,
                                # Ixz, Iyz) or a 3x3 table
-gravity = [0, 0, -9.81]        # top level, optional [m/s^2]
+gravity = [0, 0, -9.81]        # top level, optional [m/s^2], in the world frame
+[base]                         # optional: frame 0 in the world; [tool] likewise: the tool in frame n
+xyz = [0.0, 0.0, 0.5]          # translation [m] (optional, default zeros)
+rpy = [0.0, 0.0, 1.57]         # URDF roll-pitch-yaw [rad], R = Rz(yaw)·Ry(pitch)·Rx(roll)
+                               # (optional, default zeros), or rpy_deg = [0, 0, 90]
 """
 
 from __future__ import annotations
@@ -36,7 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _validate as V
-from .chain import MAX_JOINTS, AChain
+from .chain import MAX_JOINTS, AChain, frame
 from .collisions import check_design
 from .link import Link
 from .pair import KINDS, APair
@@ -49,7 +53,8 @@ _PAIR_KEYS = {
 _DH_KEYS = {"a", "alpha", "alpha_deg", "offset", "theta_offset", "theta_offset_deg", "limits", "limits_deg"}
 _LINK_KEYS = {"mass", "com", "inertia"}
 _JOINT_KEYS = set().union(*_PAIR_KEYS.values()) | _DH_KEYS | _LINK_KEYS | {"pair"}
-_TOP_KEYS = {"name", "description", "gravity", "joint"}
+_TOP_KEYS = {"name", "description", "gravity", "joint", "base", "tool"}
+_FRAME_KEYS = {"xyz", "rpy", "rpy_deg"}
 TURN = 2 * math.pi  # an angle in radians beyond ±TURN is surely one in degrees
 
 
@@ -249,6 +254,31 @@ def _joint(w: str, j: object) -> tuple[APair, float, float, float, float, Link]:
     return pair, a, _angle(w, j, "alpha"), offset, _angle(w, j, "theta_offset", 0.0), _link(w, j)
 
 
+def _frame(where: str, table: str, data: dict[str, Any]) -> NDArray[np.float64] | None:
+    """The transform of the [base] or [tool] table (`table`), None without one: xyz [m] and rpy
+    [rad] or rpy_deg, both optional (zeros)."""
+    if table not in data:
+        return None
+    w = f"{where}: {table}"
+    t = data[table]
+    if not isinstance(t, dict):
+        raise ValueError(f"{w}: expected a [{table}] table (xyz, rpy or rpy_deg), got {_short(t)}")
+    unknown = sorted(set(t) - _FRAME_KEYS)
+    if unknown:
+        more = f" (and {len(unknown) - 3} more)" if len(unknown) > 3 else ""
+        raise ValueError(f"{w}: {_guessed(unknown[:3], _FRAME_KEYS)}{more}")
+    if "rpy" in t and "rpy_deg" in t:
+        raise ValueError(f"{w}: give rpy or rpy_deg, not both")
+    xyz = _numbers(f"{w}.xyz", t.get("xyz", [0.0, 0.0, 0.0]), [(3,)])
+    V.in_range(f"{w}.xyz", xyz, "m")
+    if "rpy_deg" in t:
+        rpy = np.radians(_numbers(f"{w}.rpy_deg", t["rpy_deg"], [(3,)]))
+    else:
+        rpy = _numbers(f"{w}.rpy", t.get("rpy", [0.0, 0.0, 0.0]), [(3,)])
+        _check_turn(w, "rpy", t.get("rpy"), rpy)
+    return frame(xyz, rpy)
+
+
 def chain_from_dict(data: dict[str, Any], where: str = "chain") -> AChain:
     """Build an AChain from the parsed TOML document (named by its `name` if it has one). Keys
     and text fields are checked first, then sizes (the number of joints, every list's shape),
@@ -267,11 +297,14 @@ def chain_from_dict(data: dict[str, Any], where: str = "chain") -> AChain:
         raise ValueError(f"{where}: pairs: a chain has 1 to {MAX_JOINTS} pairs, got {len(joints)} [[joint]] tables")
     gravity = _numbers(f"{where}: gravity", data.get("gravity", [0.0, 0.0, -9.81]), [(3,)])
     V.in_range(f"{where}: gravity", gravity, "m/s^2")
+    base, tool = _frame(where, "base", data), _frame(where, "tool", data)
     names = [f"{where}: joint {i + 1}" for i in range(len(joints))]
     pairs, a, alpha, offset, theta_offset, links = zip(*(_joint(w, j) for w, j in zip(names, joints)))
     limits = [_limits(w, j, pair) for w, j, pair in zip(names, joints, pairs)]
     try:
-        chain = AChain(pairs, a, alpha, offset, theta_offset, links=links, gravity=gravity, limits=limits)
+        chain = AChain(
+            pairs, a, alpha, offset, theta_offset, links=links, gravity=gravity, limits=limits, base=base, tool=tool
+        )
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
     if name is not None:

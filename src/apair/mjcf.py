@@ -16,7 +16,11 @@ Body tree, in the frames of docs/conventions.md §3:
   fraction of the transverse inertia if ρ = 0). The spin never couples: nothing acts about the
   axis.
 - Sites `pair{i}_base` (frame i−1 at the pair's base, z along its axis) and `pair{i}_platform`
-  (the platform frame) give θ_i and d_i to any MuJoCo user; `end_effector` is frame n.
+  (the platform frame) give θ_i and d_i to any MuJoCo user; `end_effector` is frame n, `tool` the
+  tool frame (frame n · chain.tool: its world pose is chain.fk(q)), on link n; `base` (a site of the
+  world) is frame 0.
+- The world is apair's world (gravity as chain.gravity): frame 0 is placed at chain.base, so the
+  first pair's base plate, legs, site and link body sit at the base's pose.
 - One motor per pair (`pair{i}_motor`) on the hinge: ctrl = τ_i, the torque about axis i.
 - Plates (triangles of the pair's radii) and legs are visible geoms that do not collide unless
   `collisions=True`.
@@ -86,6 +90,15 @@ def _link_offset(chain: ChainLike, i: int) -> tuple[NDArray[np.float64], NDArray
     law = call("law_revolute", [0.0])[0]
     T = call("fk1", law[None, :], chain._dh[i][None, :])[0]
     return T[:3, :3], T[:3, 3]
+
+
+def _frames(chain: ChainLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(base, tool): the chain's base and tool transforms (4, 4), the identity where it has none."""
+    base, tool = getattr(chain, "base", None), getattr(chain, "tool", None)
+    return (
+        np.eye(4) if base is None else np.asarray(base, float),
+        np.eye(4) if tool is None else np.asarray(tool, float),
+    )
 
 
 def _reference_legs(pair: PairLike) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
@@ -249,9 +262,11 @@ def to_mjcf(
             f'size="{_f(radius)}" {col} rgba="{rgba}"/>'
         )
 
-    # frame i−1 in the current body: (R, p); the world carries frame 0
-    R_prev, p_prev = np.eye(3), np.zeros(3)
+    # frame i−1 in the current body: (R, p); the world carries frame 0 at the chain's base
+    base, tool = _frames(chain)
+    R_prev, p_prev = base[:3, :3], base[:3, 3]
     indent = "    "
+    out.append(f'{indent}<site name="base" pos="{_f(p_prev)}" quat="{_f(_quat(R_prev))}" size="0.01"/>')
     for i, pair in enumerate(chain.pairs):
         n1 = i + 1
         size = _size(chain, i)
@@ -313,6 +328,8 @@ def to_mjcf(
         R_prev, p_prev = R_off, p_off
         indent = ind
     out.append(f'{indent}<site name="end_effector" pos="{_f(p_prev)}" quat="{_f(_quat(R_prev))}" size="0.01"/>')
+    p_tool, R_tool = p_prev + R_prev @ tool[:3, 3], R_prev @ tool[:3, :3]
+    out.append(f'{indent}<site name="tool" pos="{_f(p_tool)}" quat="{_f(_quat(R_tool))}" size="0.01"/>')
     for _ in range(chain.n):
         indent = indent[:-2]
         out.append(f"{indent}</body>")

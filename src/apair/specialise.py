@@ -47,8 +47,20 @@ def _toolkit() -> tuple[ModuleType, ModuleType]:
     return specialised, emitter
 
 
+def check_frames(chain: ChainLike) -> None:
+    """Refuses a chain with base or tool frames (AChain's `base`, `tool`): the generated kernels
+    are of the DH chain alone, with gravity in its frame 0."""
+    if getattr(chain, "_framed", False):
+        raise ValueError(
+            "base/tool frames are not yet in the generated code; specialise or generate the chain "
+            "without [base] and [tool] (base=None, tool=None) and compose them yourself"
+        )
+
+
 def design_of(chain: ChainLike) -> Any:
-    """The chain's constants as derivations.specialised.Design (plain numbers)."""
+    """The chain's constants as derivations.specialised.Design (plain numbers); a chain with base
+    or tool frames is refused (`check_frames`)."""
+    check_frames(chain)
     specialised, _ = _toolkit()
     return specialised.Design(
         kinds=tuple(p.kind for p in chain.pairs),
@@ -246,6 +258,7 @@ def write_code(
     earlier run did not write (a user's own, a symbolic link) is refused unless `force`; stale
     files of an earlier run are removed only while unedited (codegen/output.py). Returns the
     changes."""
+    check_frames(chain)
     _, emitter = _toolkit()
     files = render(chain, name, origin, kernels, title)
     try:

@@ -3,7 +3,8 @@ slider per joint.
 
 The page's kinematics are the generated JavaScript kernels (generated/js/apair_kernels.js, from
 the derivations like the C and NumPy kernels): each joint's law, its transform fk1 (multiplied
-into every frame), and pair_legs for the legs. Nothing in the page retypes a formula. The legs'
+into every frame, from the chain's base on; the tool frame after frame n), and pair_legs for the
+legs. The page shows the tool's pose in the world (chain.fk). Nothing in the page retypes a formula. The legs'
 clearance (collisions.clearances: segment distances) is a table in θ, 0.25° apart, read by linear
 interpolation. The drawing is a small canvas renderer (no library, nothing fetched).
 """
@@ -61,7 +62,8 @@ def _name(chain: ChainLike) -> str:
 
 def chain_data(chain: ChainLike, workspace: int = 0, seed: int = 0) -> dict[str, Any]:
     """What the page needs of the chain: its joints (law kernel and parameters, DH row, range),
-    the A-pairs' radii and clearance tables, and optionally `workspace` sampled end points."""
+    the A-pairs' radii and clearance tables, its base and tool frames, and optionally `workspace`
+    sampled tool origins (in the world)."""
     lim = np.array(chain.limits, float)
     joints: list[dict[str, Any]] = []
     for i, p in enumerate(chain.pairs):
@@ -82,7 +84,15 @@ def chain_data(chain: ChainLike, workspace: int = 0, seed: int = 0) -> dict[str,
             j["leg_radius"] = float(p.leg_radius)
             j["clearance"] = _clearance_table(p, lo, hi)
         joints.append(j)
-    data: dict[str, Any] = {"name": _name(chain), "n": chain.n, "joints": joints}
+    base, tool = (getattr(chain, key, None) for key in ("base", "tool"))
+    data: dict[str, Any] = {
+        "name": _name(chain),
+        "n": chain.n,
+        "joints": joints,
+        # frame 0 in the world and the tool in frame n, 4x4 row-major (docs/conventions.md)
+        "base": np.eye(4).ravel().tolist() if base is None else np.asarray(base, float).ravel().tolist(),
+        "tool": np.eye(4).ravel().tolist() if tool is None else np.asarray(tool, float).ravel().tolist(),
+    }
     if workspace:
         rng = np.random.default_rng(seed)
         q = rng.uniform([j["lower"] for j in joints], [j["upper"] for j in joints], (workspace, chain.n))

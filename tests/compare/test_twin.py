@@ -71,3 +71,20 @@ def test_a_subclass_chain_gets_a_plain_twin():
     chain = OnItsOwnKernels(mixed())
     other = twin.build(chain)
     assert type(other) is apair.AChain and [p.kind for p in other.pairs] == ["revolute"] * 3
+
+
+def test_the_twin_keeps_the_base_and_tool_frames():
+    """A chain with base and tool frames: its twin has the same frames, so both are measured in
+    one world frame (gravity there too): the twin's poses are those of the frameless twin with
+    the frames around them."""
+    plain = arm3a()
+    base = apair.frame([0.1, -0.2, 0.3], [0.2, -0.4, 1.1])
+    tool = apair.frame([0.0, 0.05, 0.12], [0.0, np.pi / 2, 0.0])
+    framed = apair.AChain(
+        plain.pairs, plain.a, plain.alpha, plain.offset, plain.theta_offset, links=plain.links, base=base, tool=tool
+    )
+    tw = twin.build(framed)
+    assert np.array_equal(tw.base, base) and np.array_equal(tw.tool, tool)
+    q = np.random.default_rng(3).uniform(-1, 1, (5, plain.n))
+    expected = base @ twin.build(plain).fk(q) @ tool
+    assert np.allclose(tw.fk(q), expected, atol=1e-12)

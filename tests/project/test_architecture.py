@@ -127,3 +127,10 @@ def test_no_hand_written_module_is_too_long():
     assert paths and c_files
     long = {p: n for p, n in sorted(sizes.items()) if n > MAX_LINES}
     assert not long, f"modules over {MAX_LINES} lines: {long}"
+
+
+def test_test_files_have_unique_names():
+    """pytest imports test modules by their base name (rootdir import mode): two test_x.py in
+    different folders would stop the collection of the second."""
+    names = [p.name for p in (Path(__file__).resolve().parents[1]).rglob("test_*.py")]
+    assert sorted(n for n in set(names) if names.count(n) > 1) == []

@@ -9,7 +9,7 @@ import sys
 from collections.abc import Sequence
 
 from .._version import __version__
-from . import compare, exports, info, motion, reach
+from . import compare, exports, importer, info, motion, reach
 from .args import NEGATIVE_NUMBER
 from .output import one_line
 
@@ -28,6 +28,7 @@ COMMANDS = (
     compare.add_compare,
     exports.add_codegen,
     exports.add_export,
+    importer.add_import,
     exports.add_view,
     info.add_kernels,
     info.add_demo,

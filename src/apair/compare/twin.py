@@ -39,6 +39,10 @@ class Chain(Protocol):
     @property
     def gravity(self) -> NDArray[np.float64]: ...
     @property
+    def base(self) -> NDArray[np.float64]: ...
+    @property
+    def tool(self) -> NDArray[np.float64]: ...
+    @property
     def limits(self) -> NDArray[np.float64]: ...
     def hard_limits(self) -> NDArray[np.float64]: ...
     def fk(self, q: ArrayLike) -> NDArray[np.float64]: ...
@@ -99,6 +103,8 @@ def build(chain: Chain, twin: str = "revolute") -> Chain:
         links=chain.links,
         gravity=chain.gravity,
         limits=limits,
+        base=chain.base,
+        tool=chain.tool,
     )
     cast(Any, out).name = f"{name_of(chain)} ({twin} twin)"
     return out
