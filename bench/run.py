@@ -42,6 +42,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from design_bench import design_targets, time_design  # bench/ is sys.path[0] when run as a script
 
 import apair
 from apair import kernels
@@ -1010,7 +1011,10 @@ def main(argv=None) -> int:
     results["ik_local_single"] = time_ik_local_single(args.quick, pin_ok)
     results["make_generate_s"] = None if args.no_generate else time_generate()
     results["codegen_6_s"] = time_codegen(random_achain(6, rng))
-    results["targets"] = targets(results) + ik_local_targets(results["ik_local_single"])
+    results["design"] = time_design(quick=args.quick)
+    results["targets"] = (
+        targets(results) + ik_local_targets(results["ik_local_single"]) + design_targets(results["design"])
+    )
 
     print("\nper evaluation, median over repeats (ratio = peer time / batched C time):")
     cols = [

@@ -134,3 +134,15 @@ def test_test_files_have_unique_names():
     different folders would stop the collection of the second."""
     names = [p.name for p in (Path(__file__).resolve().parents[1]).rglob("test_*.py")]
     assert sorted(n for n in set(names) if names.count(n) > 1) == []
+
+
+def test_every_subpackage_ships():
+    """Every package folder under src/apair is listed in pyproject's packages: a wheel (not the
+    editable install the tests use) would leave out one that is not."""
+    import tomllib
+
+    root = Path(__file__).resolve().parents[2]
+    listed = set(tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    src = root / "src" / "apair"
+    found = {"apair." + ".".join(p.parent.relative_to(src).parts) for p in src.rglob("__init__.py")}
+    assert sorted(found - {"apair."} - listed) == []

@@ -9,7 +9,7 @@ import sys
 from collections.abc import Sequence
 
 from .._version import __version__
-from . import compare, exports, importer, info, motion, reach
+from . import compare, design, exports, importer, info, motion, reach
 from .args import NEGATIVE_NUMBER
 from .output import one_line
 
@@ -26,6 +26,7 @@ COMMANDS = (
     motion.add_limits,
     reach.add_workspace,
     compare.add_compare,
+    design.add_design,
     exports.add_codegen,
     exports.add_export,
     importer.add_import,

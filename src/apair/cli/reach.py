@@ -27,8 +27,8 @@ def _cmd_ik(args: argparse.Namespace) -> int:
 
     chain = load(args.file)
     T = A.pose(args.pose)
-    with A.named({"T": "POSE"}, joints={"pairs": args.file}):
-        sol = chain.ik(T, full=True)
+    with A.named({"T": "POSE", "fix": "--fix"}, joints={"pairs": args.file}):
+        sol = chain.ik(T, full=True, fix=_held(args.fix, args.deg))
         nearest = None if len(sol.q) else nearest_pose(chain, T)
     inside = cast(NDArray[np.bool_], sol.inside)  # set by full=True
     if args.json:
@@ -190,16 +190,38 @@ def _cmd_workspace(args: argparse.Namespace) -> int:
 
 def add_ik(sub: Sub) -> None:
     p = sub.add_parser("ik", help="all inverse kinematics solutions of a chain file at a pose")
-    p.add_argument("file", help="a chain TOML file (1 to 6 sinusoidal A-pairs or R-pairs)")
+    p.add_argument("file", help="a chain TOML file (1 to 6 sinusoidal A-pairs or R-pairs; 7 with --fix)")
     p.add_argument(
         "pose",
         nargs="+",
         metavar="POSE",
         help="a 4x4 transform row by row (16 numbers, or the top 12) or a Study point (8)",
     )
-    p.add_argument("--deg", action="store_true", help="also print the angles in degrees")
+    p.add_argument("--deg", action="store_true", help="also print the angles in degrees (and read --fix in degrees)")
+    p.add_argument(
+        "--fix",
+        action="append",
+        default=[],
+        metavar="K=VALUE",
+        help="hold joint K (from 1) at VALUE [rad, or deg with --deg] and solve for the others; repeatable",
+    )
     add_json(p)
     p.set_defaults(func=_cmd_ik)
+
+
+def _held(words: list[str], deg: bool) -> dict[int, float] | None:
+    """--fix K=VALUE words as {K: value [rad]}; None when none is given."""
+    held: dict[int, float] = {}
+    for word in words:
+        key, sep, value = word.partition("=")
+        try:
+            k, x = int(key), float(value)
+        except ValueError:
+            k, x = 0, float("nan")
+        if not sep or k < 1 or not np.isfinite(x) or k in held:
+            raise ValueError(f"--fix: expected K=VALUE with a joint K from 1 (once each) and a finite value, got {word!r}")
+        held[k] = float(np.radians(x)) if deg else x
+    return held or None
 
 
 def add_ik_prepare(sub: Sub) -> None:
