@@ -36,6 +36,7 @@ DERIVATIONS = (
 ROOT = Path(__file__).resolve().parent.parent
 # Rough cost of each job on one core [s], for scheduling the longest first.
 COST = {
+    ("chain_dynamics", 7): 55,
     ("chain_dynamics", 6): 40,
     ("chain_dynamics", 5): 28,
     ("chain_dynamics", 4): 20,

@@ -1,4 +1,4 @@
-"""Equations of motion of nA-chains with leg inertia, n = 1..6 (docs/conventions.md §3-§4).
+"""Equations of motion of nA-chains with leg inertia, n = 1..7 (docs/conventions.md §3-§4).
 
 Generalised coordinates: the angles θ, entering through each joint's law values (cos(θ/2),
 sin(θ/2), d, d', d''). Body j (j ≥ 1) is link j: it carries pair j's platform and frame j.

@@ -1,4 +1,4 @@
-"""Direct kinematics and geometric Jacobians of nA-chains, n = 1..6 (docs/conventions.md §3-§4).
+"""Direct kinematics and geometric Jacobians of nA-chains, n = 1..7 (docs/conventions.md §3-§4).
 
 A_i(θ_i) = Rz(θ_i + φ_i) · Tz(c_i + d_i) · Tx(a_i) · Rx(α_i), each factor built from its elementary
 motion, both as a 4x4 matrix and as a Study point (dual-quaternion product). Each joint enters
@@ -24,7 +24,7 @@ from .quaternions import Quaternion, StudyPoint, rotation, translation
 from .spec import Arg, Entry, KernelSpec, PolynomialSet
 
 SOURCE = "derivations/chain_kinematics.py"
-MAX_N = 6
+MAX_N = 7
 
 
 LAW_FIELDS = ("ch", "sh", "d", "dd", "ddd")

@@ -6,7 +6,8 @@ The closed forms are derived symbolically (derivations/), emitted as C and NumPy
 
 from . import plots, polynomials  # plots imports matplotlib only when a picture is drawn
 from ._version import __version__
-from .chain import AChain, frame
+from .chain import AChain
+from .frames import frame
 from .io import load
 from .kernels import backend, c_available, set_backend
 from .link import Link

@@ -14,7 +14,7 @@
  */
 #include "_native.h"
 
-#define MAX_JOINTS 6
+#define MAX_JOINTS 7
 #define MAX_METHODS 16
 #define MAX_DESIGN 8
 #define CHAIN_BLOCK 512 /* items whose law values are formed before the chain kernel runs on them */

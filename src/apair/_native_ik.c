@@ -227,7 +227,7 @@ static const ik_entry ik_entries[] = {
                    {"upper", F64, 1, {N}}, {"target", F64, 3, {ANY, 4, 4}}, {"seed", F64, 2, {ANY, N}}},
         .out = {{"q", F64, 2, {ROWS, N}}, {"residual", F64, 1, {ROWS}}, {"converged", I32, 1, {ROWS}}},
         .rows = 7, .nogil = 1, .prepare = prepare_local, .run = run_local,
-        .error = "ik_local: the chain is not valid (kinds 0, 1 or 2; 1 to 6 joints)",
+        .error = "ik_local: the chain is not valid (kinds 0, 1 or 2; 1 to 7 joints)",
     },
     [IK4_PENCIL] = {
         .format = "OOOOOdid", /* C, Qf, af, Qg, ag, cond_max, deflate, deflate_tol */
@@ -385,7 +385,7 @@ static PyObject *ik4_left(PyObject *m, PyObject *args) { return ik_marshal(m, IK
  * the caller then validates, and raises the one-line ValueError that names the argument, or
  * converts. So the two paths cannot disagree on what is an error, nor on the numbers. */
 
-#define LOCAL_NMAX 6
+#define LOCAL_NMAX 7
 #define LOCAL_ORTHO 0.5e-9          /* half of apair.ik.poses.check_matrix's tolerance 1e-9 */
 #define LOCAL_LAST_TOL 1e-12        /* check_matrix: |last row - [0, 0, 0, 1]| <= 1e-12 ... */
 #define LOCAL_LAST_TOL_ONE 1e-5     /* ... + 1e-5 for the 1 */
@@ -583,7 +583,7 @@ static PyObject *local_call(LocalIKObject *self, PyObject *const *args, Py_ssize
     *(npy_bool *)PyArray_DATA((PyArrayObject *)out[2]) = converged != 0;
     result = rc == 0 ? PyObject_Vectorcall(self->result, out, 3, NULL) : NULL;
     if (rc != 0) {
-        PyErr_SetString(PyExc_ValueError, "ik_local: the chain is not valid (kinds 0, 1 or 2; 1 to 6 joints)");
+        PyErr_SetString(PyExc_ValueError, "ik_local: the chain is not valid (kinds 0, 1 or 2; 1 to 7 joints)");
     }
     Py_DECREF(out[0]);
     Py_DECREF(out[1]);

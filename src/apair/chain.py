@@ -9,11 +9,10 @@ otherwise the validating path checks and converts them first. Batches stay in th
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import math
 import os
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, Literal, cast, overload
 
 import numpy as np
@@ -21,6 +20,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _validate as V
 from .files import write_text
+from .frames import EYE4, check_frame, inverse
+from .hold import held_ik
 from .kernels import call, native_chain
 from .link import Link
 from .pair import APair
@@ -35,7 +36,7 @@ if TYPE_CHECKING:
     from .variety import Variety
     from .workspace import Workspace
 
-MAX_JOINTS = 6
+MAX_JOINTS = 7
 MAX_ITER = 100_000  # ik_local: Levenberg-Marquardt steps per seed, a bound on the work asked for
 # The kernel-backed methods in the order of their native fast path (apair.kernels.native_chain):
 # (kernel family, whether a joint at its range end is refused because d' is unbounded there).
@@ -51,66 +52,6 @@ METHODS = (
     ("forward_dynamics", True),
     ("energy", True),
 )
-
-
-FRAME_TOL = 1e-9  # a base or tool rotation is orthonormal to this (largest entry of |RᵀR − I|)
-_EYE4 = np.eye(4)
-_EYE4.flags.writeable = False
-
-
-def rpy_matrix(rpy: ArrayLike) -> NDArray[np.float64]:
-    """(3, 3): URDF's fixed-axis roll-pitch-yaw rotation Rz(yaw)·Ry(pitch)·Rx(roll) [rad]."""
-    r, p, y = np.asarray(rpy, float)
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
-def frame(xyz: ArrayLike = (0.0, 0.0, 0.0), rpy: ArrayLike = (0.0, 0.0, 0.0)) -> NDArray[np.float64]:
-    """(4, 4): the rigid transform of a translation xyz [m] and a URDF roll-pitch-yaw rpy [rad]
-    (`rpy_matrix`), as a chain's `base` or `tool`."""
-    T = np.eye(4)
-    T[:3, :3] = rpy_matrix(V.vector("rpy", rpy, 3))
-    T[:3, 3] = V.vector("xyz", xyz, 3)
-    return T
-
-
-def check_frame(name: str, value: object) -> NDArray[np.float64] | None:
-    """A base or tool transform, validated: (4, 4), finite, the rotation orthonormal to FRAME_TOL
-    with det +1, last row exactly [0, 0, 0, 1], the translation within the length range apair
-    computes in. Returns a read-only float64 copy, or None for None or the identity exactly (no
-    frame: the methods skip the composition)."""
-    if value is None:
-        return None
-    T = np.array(V.real_array(name, value), dtype=np.float64)
-    if T.shape != (4, 4):
-        raise ValueError(f"{name}: expected a 4x4 rigid transform, got shape {T.shape}")
-    if not np.array_equal(T[3], [0.0, 0.0, 0.0, 1.0]):
-        raise ValueError(f"{name}: last row must be [0, 0, 0, 1], got {T[3].tolist()}")
-    R = T[:3, :3]
-    err = float(np.abs(R.T @ R - np.eye(3)).max())
-    if err > FRAME_TOL:
-        raise ValueError(f"{name}: the rotation part is not orthonormal (|RᵀR − I| = {err:.3g} > {FRAME_TOL:g})")
-    if np.linalg.det(R) < 0:
-        raise ValueError(f"{name}: the rotation part is a reflection (det −1), not a rotation")
-    V.in_range(f"{name} translation", T[:3, 3], "m")
-    if np.array_equal(T, _EYE4):
-        return None
-    T.flags.writeable = False
-    return T
-
-
-def _inverse(T: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The inverse of a rigid transform."""
-    out = np.eye(4)
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -(T[:3, :3].T @ T[:3, 3])
-    return out
 
 
 class AChain:
@@ -220,11 +161,11 @@ class AChain:
     def _set_frames(self) -> None:
         """The frames' derived constants: the transforms (identity for none), their Study points
         and inverses, the tool's offset (None if zero)."""
-        B = _EYE4 if self._base_T is None else self._base_T
-        T = _EYE4 if self._tool_T is None else self._tool_T
+        B = EYE4 if self._base_T is None else self._base_T
+        T = EYE4 if self._tool_T is None else self._tool_T
         self._B, self._T = B, T
         self._B_study, self._T_study = from_matrix(B), from_matrix(T)
-        self._B_inv, self._T_inv = _inverse(B), _inverse(T)
+        self._B_inv, self._T_inv = inverse(B), inverse(T)
         self._tool_offset = None if not T[:3, 3].any() else T[:3, 3].copy()
 
     def _framed_call(self, method: int, *args: Any) -> NDArray[np.float64] | None:
@@ -257,7 +198,8 @@ class AChain:
         ik and ik_local solve for T_dh = base⁻¹ · T · tool⁻¹ (the joint values are the same)."""
         if not self._framed:
             return self
-        plain = copy.copy(self)
+        plain = object.__new__(AChain)  # a plain AChain even of a SpecialisedChain: no code reloaded
+        plain.__dict__.update(self.__dict__)
         plain.__dict__.update(_base_T=None, _tool_T=None, _framed=False, _ik=None, _local_ik=None)
         plain.gravity = self._gravity.copy()
         plain._use(self._fast)
@@ -500,8 +442,7 @@ class AChain:
         the same methods, faster. `kernels`: a subset of fk, fk_study, jacobian, mass_matrix,
         coriolis, gravity_torques, bias, inverse_dynamics, forward_dynamics, energy (default: all;
         the others stay generic). Without a C compiler it warns once and uses the generic kernels
-        (`.specialised` says which). A chain with base or tool frames is refused (not yet in the
-        generated code)."""
+        (`.specialised` says which). Base and tool frames are built in (apair.specialise)."""
         from .specialise import check_frames
 
         check_frames(self)
@@ -586,18 +527,48 @@ class AChain:
     # ----------------------------------------------------------------------------- inverse kinematics
     @overload
     def ik(
-        self, T: ArrayLike, tol: float = ..., full: Literal[False] = ..., within_limits: bool = ...
+        self,
+        T: ArrayLike,
+        tol: float = ...,
+        full: Literal[False] = ...,
+        within_limits: bool = ...,
+        fix: Mapping[int, float] | None = ...,
     ) -> NDArray[np.float64]: ...
     @overload
-    def ik(self, T: ArrayLike, tol: float = ..., *, full: Literal[True], within_limits: bool = ...) -> Solution: ...
-    @overload
-    def ik(self, T: ArrayLike, tol: float, full: Literal[True], within_limits: bool = ...) -> Solution: ...
+    def ik(
+        self,
+        T: ArrayLike,
+        tol: float = ...,
+        *,
+        full: Literal[True],
+        within_limits: bool = ...,
+        fix: Mapping[int, float] | None = ...,
+    ) -> Solution: ...
     @overload
     def ik(
-        self, T: ArrayLike, tol: float = ..., full: bool = ..., within_limits: bool = ...
+        self,
+        T: ArrayLike,
+        tol: float,
+        full: Literal[True],
+        within_limits: bool = ...,
+        fix: Mapping[int, float] | None = ...,
+    ) -> Solution: ...
+    @overload
+    def ik(
+        self,
+        T: ArrayLike,
+        tol: float = ...,
+        full: bool = ...,
+        within_limits: bool = ...,
+        fix: Mapping[int, float] | None = ...,
     ) -> NDArray[np.float64] | Solution: ...
     def ik(
-        self, T: ArrayLike, tol: float = 1e-9, full: bool = False, within_limits: bool = False
+        self,
+        T: ArrayLike,
+        tol: float = 1e-9,
+        full: bool = False,
+        within_limits: bool = False,
+        fix: Mapping[int, float] | None = None,
     ) -> NDArray[np.float64] | Solution:
         """All real joint vectors q (k, n) with fk(q) = T, each verified (largest entry of
         |fk(q) − T| ≤ tol); (0, n) when T is out of reach. T: a 4×4 transform or a Study point,
@@ -605,7 +576,7 @@ class AChain:
         base⁻¹·T·tool⁻¹ in frame 0, where the check and `error` are measured).
         within_limits=True keeps only the solutions inside `limits` (no collisions).
 
-        Chains of 1 to 6 sinusoidal A-pairs or R-pairs. n ≤ 4 by kinematic mapping (see
+        Chains of 1 to 6 sinusoidal A-pairs or R-pairs (7 with `fix`). n ≤ 4 by kinematic mapping (see
         apair.ik.elimination4): the left half's constraint variety on the right part's image,
         eliminated to eigenvalue and univariate problems. 5 and 6 R-pairs by the 6R elimination
         (apair.ik.elimination6r) where it certifies its 16 solutions, chains with one A-pair by
@@ -613,6 +584,12 @@ class AChain:
         apair.ik.homotopy) from the design's start system (`prepare_ik`, cached on disk), every
         complex solution tracked to T.
         Angles in (−2π, 2π] for A-pairs, (−π, π] for R-pairs.
+        fix={k: value, ...} (joints from 1): those joints held at those values [rad], the rest solved
+        (needed for 7 joints, whose poses have a continuum of solutions: ik_local gives the one
+        nearest a seed). The held joint's transform is folded into the base (k = 1), the tool
+        (k = n) or, exactly, into the DH constants of its neighbours (`apair.hold`): a chain of n − len(fix)
+        joints, solved as above; q (k, n) has q[:, k − 1] = value and `error` is measured on this
+        chain. Refused (one line) where joints k − 1 and k + 1 are nearly parallel at that value.
         full=True returns an `apair.ik.Solution`: q, error, candidates, complex_count, `inside`
         (whether each solution is within `limits`) and `certified` (False where the elimination
         degenerated and a local search supplied the solutions, or, for n = 5, 6, the start set's
@@ -622,6 +599,13 @@ class AChain:
 
         tol = V.scalar("tol", tol, positive=True)
         full, within_limits = V.flag("full", full), V.flag("within_limits", within_limits)
+        if fix is not None:
+            return held_ik(self, T, tol, full, within_limits, fix, AChain)
+        if self.n > 6:
+            raise ValueError(
+                f"fix: a {self.n}-joint chain reaches a pose along a continuum of joint vectors: hold a "
+                "joint with ik(T, fix={k: value}) (k from 1) or take the solution nearest a seed with ik_local(T, q0)"
+            )
         if self._ik is None:
             self._ik = Solver(self._dh_chain())
         if self._framed:
@@ -652,10 +636,10 @@ class AChain:
         .trace)."""
         from .ik import homotopy
 
-        if self.n < 5:
+        if not 5 <= self.n <= 6:
             raise ValueError(
                 f"chain: start systems are for 5 and 6 joints (this chain has {self.n}; its ik is "
-                "solved by elimination)"
+                + ("solved by elimination)" if self.n < 5 else "solved with fix={k: value}, one joint held)")
             )
         certify: Callable[..., StartSystem] | None = None
         if trace:

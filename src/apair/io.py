@@ -40,7 +40,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _validate as V
-from .chain import MAX_JOINTS, AChain, frame
+from .chain import MAX_JOINTS, AChain
+from .frames import frame
 from .collisions import check_design
 from .link import Link
 from .pair import KINDS, APair

@@ -5,6 +5,11 @@ The kernels come from derivations/specialised.py (the generic chain kernels with
 in), lowered and printed by the one emitter (codegen/emitter.py). Both ship inside the installed
 package as apair.derivations and apair.codegen. The self-test's reference values are computed here
 by the generic runtime, so the generated code is checked against an independent evaluation.
+
+Base and tool frames (docs/conventions.md §9): the kernels are of the DH chain with gravity in its
+frame 0 (R_baseᵀ·g); the generated fk, fk_study and jacobian compose the frames around them (their
+frame-0 versions stay, as name_fk_dh, ...), and the content hash covers the frames. The runtime's
+registry (AChain.specialise) holds the frame-0 kernels: the chain composes its frames itself.
 """
 
 from __future__ import annotations
@@ -18,13 +23,14 @@ from collections.abc import Iterable, Sequence
 from importlib import resources
 from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
 from . import _validate as V
 from .files import cache_root, toolkit_digest
+from .frames import check_frame
 
 if TYPE_CHECKING:
     from ._typing import ChainLike
@@ -47,34 +53,86 @@ def _toolkit() -> tuple[ModuleType, ModuleType]:
     return specialised, emitter
 
 
+def frames_of(chain: ChainLike) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
+    """The chain's base and tool transforms (AChain's `base`, `tool`), validated again
+    (apair.frames.check_frame); None for the identity (no frame)."""
+    return check_frame("base", getattr(chain, "_base_T", None)), check_frame("tool", getattr(chain, "_tool_T", None))
+
+
 def check_frames(chain: ChainLike) -> None:
-    """Refuses a chain with base or tool frames (AChain's `base`, `tool`): the generated kernels
-    are of the DH chain alone, with gravity in its frame 0."""
-    if getattr(chain, "_framed", False):
-        raise ValueError(
-            "base/tool frames are not yet in the generated code; specialise or generate the chain "
-            "without [base] and [tool] (base=None, tool=None) and compose them yourself"
-        )
+    """Checks the chain's base and tool frames (`frames_of`); a chain with frames is accepted: the
+    generated fk, fk_study and jacobian compose them, the dynamics take gravity in frame 0."""
+    frames_of(chain)
 
 
 def design_of(chain: ChainLike) -> Any:
-    """The chain's constants as derivations.specialised.Design (plain numbers); a chain with base
-    or tool frames is refused (`check_frames`)."""
-    check_frames(chain)
+    """The chain's constants as derivations.specialised.Design (plain numbers); gravity in frame 0
+    (R_baseᵀ·g with a base frame, as the chain's kernels take it). The frames themselves are
+    `frame_constants`."""
     specialised, _ = _toolkit()
+    gravity = getattr(chain, "_gravity", None)
     return specialised.Design(
         kinds=tuple(p.kind for p in chain.pairs),
         law=tuple(tuple(float(x) for x in p.law_kernel[1]) for p in chain.pairs),
         dh=tuple(tuple(float(x) for x in row) for row in chain._dh),
         links=tuple(tuple(float(x) for x in row) for row in chain._links),
         legs=tuple(tuple(float(x) for x in row) for row in chain._legs),
-        gravity=tuple(float(x) for x in chain.gravity),
+        gravity=tuple(float(x) for x in (chain.gravity if gravity is None else gravity)),
     )
 
 
+def frame_constants(chain: ChainLike) -> dict[str, Any] | None:
+    """The constants of the chain's base and tool frames as the generated code builds them in
+    (every number the exact double, as Python's repr): base and tool (4 rows of 4; the identity
+    for none), their Study points (apair.study.from_matrix, as AChain composes fk_study), the
+    tool's translation (None if zero: the Jacobian skips ω × r, as AChain does) and the world's
+    gravity; None for a chain without frames (the code is then byte for byte that of the DH chain)."""
+    from .study import from_matrix
+
+    base, tool = frames_of(chain)
+    if base is None and tool is None:
+        return None
+    B = np.eye(4) if base is None else base
+    T = np.eye(4) if tool is None else tool
+
+    def text(values: NDArray[np.float64]) -> list[str]:
+        return [repr(float(x)) for x in np.asarray(values).ravel()]
+
+    return {
+        "base": [text(row) for row in B],
+        "tool": [text(row) for row in T],
+        "base_study": text(from_matrix(B)),
+        "tool_study": text(from_matrix(T)),
+        "tool_offset": text(T[:3, 3]) if T[:3, 3].any() else None,
+        "gravity": text(chain.gravity),
+    }
+
+
+def _frames_canonical(chain: ChainLike) -> str:
+    """The base and tool as text, every number exact (float.hex), for the content hash; empty
+    without frames (the hash of a frameless chain is unchanged)."""
+    base, tool = frames_of(chain)
+    if base is None and tool is None:
+        return ""
+    rows = [("base", np.eye(4) if base is None else base), ("tool", np.eye(4) if tool is None else tool)]
+    return "".join(f"{what} ({', '.join(float(x).hex() for x in T.ravel())})\n" for what, T in rows)
+
+
+def kernels_for(chain: ChainLike, kernels: Iterable[str] | None) -> tuple[str, ...]:
+    """`check_kernels`, and with a tool frame that has a translation, fk with jacobian (the
+    Jacobian of the tool's origin needs frame n's rotation, which the DH fk gives)."""
+    chosen = check_kernels(kernels)
+    offset = frame_constants(chain)
+    if offset is not None and offset["tool_offset"] is not None and "jacobian" in chosen and "fk" not in chosen:
+        chosen = check_kernels(("fk", *chosen))
+    return chosen
+
+
 def content_hash(chain: ChainLike, kernels: Iterable[str]) -> str:
-    """16 hex digits identifying the generated code: the design, the kernels chosen, the toolkit."""
-    h = hashlib.sha256(design_of(chain).canonical().encode())
+    """16 hex digits identifying the generated code: the design (with the base and tool frames),
+    the kernels chosen, the toolkit."""
+    kernels = kernels_for(chain, kernels)
+    h = hashlib.sha256((design_of(chain).canonical() + _frames_canonical(chain)).encode())
     h.update((",".join(kernels) + "\0" + toolkit_digest()).encode())
     return h.hexdigest()[:16]
 
@@ -224,10 +282,10 @@ def render(
     the lowered kernels if already at hand."""
     _, emitter = _toolkit()
     name = check_prefix(name)
-    kernels = check_kernels(kernels)
+    kernels = kernels_for(chain, kernels)
     lowered_kernels, parts = code or lowered(chain, kernels)
-    tests = references(chain, lowered_kernels)
-    by_name = {k.name: k for k in lowered_kernels}
+    frames = frame_constants(chain)
+    tests = [dict(t, kernel=k) for k, t in _tests(chain, lowered_kernels, frames is not None)]
     joints, ranges = _describe(chain)
     # the title and origin go into C comments, CMake strings and Python: `_ascii`
     title = _title(title, chain.n)
@@ -240,9 +298,30 @@ def render(
         "n": chain.n,
         "hash": content_hash(chain, kernels),
     }
-    return emitter.Emitter().render_chain(
-        lowered_kernels, parts, name, meta, [dict(t, kernel=by_name[t["name"]]) for t in tests]
-    )
+    if frames is not None:  # a frameless chain's meta, and so its code, stays as it was
+        meta["frames"] = frames
+    return emitter.Emitter().render_chain(lowered_kernels, parts, name, meta, tests)
+
+
+def _tests(chain: ChainLike, kernels: list[Any], framed: bool) -> list[tuple[Any, dict[str, Any]]]:
+    """The self-test's (kernel, reference) pairs: each kernel's against the chain's method (with
+    base and tool frames, the tool's in the world); with frames, after fk, fk_study and jacobian
+    their frame-0 versions (name_dh, codegen.backends.chain.dh_kernel) against the DH chain's."""
+    from .codegen.backends.chain import backend
+
+    by_name = {k.name: k for k in kernels}
+    tests = references(chain, kernels)
+    if not framed:
+        return [(by_name[t["name"]], t) for t in tests]
+    plain = cast(Any, chain)._dh_chain()  # the DH chain, gravity in frame 0 (AChain._dh_chain)
+    dh = {t["name"]: t for t in references(plain, [k for k in kernels if k.name in backend.FRAMED])}
+    out = []
+    for t in tests:
+        out.append((by_name[t["name"]], t))
+        if t["name"] in dh:
+            k = backend.dh_kernel(by_name[t["name"]])
+            out.append((k, dict(dh[t["name"]], name=k.name)))
+    return out
 
 
 def write_code(
@@ -258,7 +337,6 @@ def write_code(
     earlier run did not write (a user's own, a symbolic link) is refused unless `force`; stale
     files of an earlier run are removed only while unedited (codegen/output.py). Returns the
     changes."""
-    check_frames(chain)
     _, emitter = _toolkit()
     files = render(chain, name, origin, kernels, title)
     try:
@@ -294,7 +372,7 @@ def build(chain: ChainLike, kernels: Iterable[str] | None = None) -> tuple[Path,
     import subprocess
     import tempfile
 
-    kernels = check_kernels(kernels)
+    kernels = kernels_for(chain, kernels)
     digest = content_hash(chain, kernels)
     name = f"spec_{digest}"
     folder = cache_root() / "specialised" / digest
@@ -310,9 +388,14 @@ def build(chain: ChainLike, kernels: Iterable[str] | None = None) -> tuple[Path,
         )
         return None
     _, emitter = _toolkit()
+    from .codegen.backends.chain import backend as chain_backend
+
     code = lowered(chain, kernels)
     files = render(chain, name, "AChain.specialise()", kernels, code=code)
-    files[f"{name}_registry.c"] = emitter.Emitter().render_chain_registry(code[0], name, digest)
+    # the runtime's registry holds the frame-0 kernels: AChain composes the base and tool itself
+    # (AChain._framed_call), exactly as for its generic kernels
+    registry = code[0] if frame_constants(chain) is None else [chain_backend.dh_of(k) for k in code[0]]
+    files[f"{name}_registry.c"] = emitter.Emitter().render_chain_registry(registry, name, digest)
     folder.parent.mkdir(parents=True, exist_ok=True)
     include = Path(str(resources.files("apair.generated"))) / "c"
     with tempfile.TemporaryDirectory(dir=folder.parent, prefix=f".{digest}-") as tmp:

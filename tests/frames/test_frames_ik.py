@@ -1,5 +1,5 @@
 """Base and tool frames (issue 38): ik and ik_local solve for the tool's pose in the world, the
-workspace is of the tool's origin in the world, and the generated code refuses frames."""
+workspace is of the tool's origin in the world, and the generated code takes the frames."""
 
 from __future__ import annotations
 
@@ -89,36 +89,58 @@ def test_workspace_points_are_tool_origins_in_the_world():
     assert dist.max() < 0.05 * np.ptp(dense, axis=0).max()
 
 
-def test_generated_code_refuses_frames(tmp_path):
-    framed, plain, *_ = pair_of_chains(np.random.default_rng(9), 2, ("revolute",))
-    with pytest.raises(ValueError, match="^base/tool frames are not yet in the generated code; ") as exc:
-        framed.specialise()
-    assert "\n" not in str(exc.value)
+def test_generated_code_takes_frames(tmp_path):
+    """Code generation no longer refuses frames: the specialised chain keeps them (fk of the tool
+    in the world, dynamics with the world's gravity), write_code writes the frames into the code,
+    the content hash depends on them; identity frames are no frames."""
+    from test_frames_kinematics import random_frame
+
     from apair import specialise
 
-    with pytest.raises(ValueError, match="^base/tool frames are not yet in the generated code; "):
-        specialise.write_code(framed, tmp_path / "out", "framed", "framed.toml")
-    assert not (tmp_path / "out").exists()
-    with pytest.raises(ValueError, match="^base/tool frames are not yet"):
-        specialise.content_hash(framed, ("fk",))
+    rng = np.random.default_rng(9)
+    framed, plain, B, Tt = pair_of_chains(rng, 2, ("revolute",))
+    q = random_q(rng, framed, (5,))
+    fast = framed.specialise(["fk", "gravity_torques"])
+    np.testing.assert_allclose(fast.fk(q), B @ plain.fk(q) @ Tt, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(fast.gravity_torques(q), framed.gravity_torques(q), rtol=0, atol=1e-12)
+    assert not np.allclose(fast.gravity_torques(q), plain.gravity_torques(q))  # the base turns gravity
+    changed = specialise.write_code(framed, tmp_path / "out", "framed", "framed.toml", kernels=["fk"])
+    assert "framed.h" in changed
+    header = (tmp_path / "out" / "framed.h").read_text()
+    assert "#define framed_BASE {" in header and "framed_fk_dh(" in header
+    assert specialise.content_hash(framed, ("fk",)) != specialise.content_hash(plain, ("fk",))
+    other = apair.AChain(
+        plain.pairs,
+        plain.a,
+        plain.alpha,
+        plain.offset,
+        plain.theta_offset,
+        links=plain.links,
+        gravity=plain.gravity,
+        base=B,
+        tool=random_frame(rng, 0.2),
+    )
+    assert specialise.content_hash(other, ("fk",)) != specialise.content_hash(framed, ("fk",))
     identity = apair.AChain(plain.pairs, plain.a, plain.alpha, base=np.eye(4), tool=None)
-    specialise.content_hash(identity, ("fk",))  # identity frames are no frames
+    bare = apair.AChain(plain.pairs, plain.a, plain.alpha)
+    assert specialise.content_hash(identity, ("fk",)) == specialise.content_hash(bare, ("fk",))
 
 
-def test_cli_codegen_refuses_a_chain_file_with_frames(tmp_path, capsys):
+def test_cli_codegen_writes_a_chain_file_with_frames(tmp_path, capsys):
+    import importlib.util
+
     from test_frames_files import FILE
 
     from apair.cli import main
 
     path = tmp_path / "framed.toml"
     path.write_text(FILE)
-    capsys.readouterr()
-    assert main(["codegen", str(path), "--out", str(tmp_path / "out")]) == 2
-    err = capsys.readouterr().err
-    assert "base/tool frames are not yet in the generated code" in err and len(err.strip().splitlines()) == 1
-    assert not (tmp_path / "out").exists()
-    plain = tmp_path / "plain.toml"
-    plain.write_text(
-        FILE.replace("[base]", "[ignored]").split("[ignored]")[0] + FILE.split("rpy_deg = [0, 90, 45]\n")[1]
-    )
-    assert main(["codegen", str(plain), "--out", str(tmp_path / "ok"), "--kernels", "fk"]) == 0
+    assert main(["codegen", str(path), "--out", str(tmp_path / "out"), "--kernels", "fk,jacobian"]) == 0
+    chain = apair.load(path)
+    spec = importlib.util.spec_from_file_location("framed_module", tmp_path / "out" / "framed.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    q = random_q(np.random.default_rng(1), chain, (4,))
+    np.testing.assert_allclose(module.fk(q), chain.fk(q), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(module.jacobian(q), chain.jacobian(q), rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(module.BASE, chain.base)

@@ -12,7 +12,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import apair
-from apair.chain import frame, rpy_matrix
+from apair.frames import frame, rpy_matrix
 from apair.study import from_matrix, to_matrix
 
 

@@ -186,7 +186,7 @@ def test_apair_replaces_a_joint(tmp_path) -> None:
 def test_rpy_round_trip() -> None:
     """matrix_rpy inverts rpy_matrix to rounding, at and near pitch ±pi/2 too (the [base] and
     [tool] tables)."""
-    from apair.chain import rpy_matrix as chain_rpy
+    from apair.frames import rpy_matrix as chain_rpy
     from apair.urdf.parse import matrix_rpy
 
     rng = np.random.default_rng(5)

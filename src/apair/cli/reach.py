@@ -219,7 +219,9 @@ def _held(words: list[str], deg: bool) -> dict[int, float] | None:
         except ValueError:
             k, x = 0, float("nan")
         if not sep or k < 1 or not np.isfinite(x) or k in held:
-            raise ValueError(f"--fix: expected K=VALUE with a joint K from 1 (once each) and a finite value, got {word!r}")
+            raise ValueError(
+                f"--fix: expected K=VALUE with a joint K from 1 (once each) and a finite value, got {word!r}"
+            )
         held[k] = float(np.radians(x)) if deg else x
     return held or None
 
