@@ -41,8 +41,8 @@ from numpy.typing import NDArray
 
 from . import _validate as V
 from .chain import MAX_JOINTS, AChain
-from .frames import frame
 from .collisions import check_design
+from .frames import frame
 from .link import Link
 from .pair import KINDS, APair
 

@@ -178,8 +178,9 @@ def test_cli_ik_with_fix(chain: apair.AChain, tmp_path, capsys) -> None:
     is one line naming --fix."""
     import json
 
-    from apair.cli import main
     from chain7_robots import panda_path
+
+    from apair.cli import main
 
     out = tmp_path / "panda.toml"
     assert main(["import", "urdf", str(panda_path()), "--tip", "panda_link8", "--out", str(out)]) == 0
