@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: e6d7866099b3212f
+Content hash: 1b3a3f30a7cbc752
 """

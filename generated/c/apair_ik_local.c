@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_local.c (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_local.c. Content hash: 00d4da3e78cddac4
+ * generated/c. Do not edit: edit src/csrc/apair_ik_local.c. Content hash: cb1f7ea7bd95909f
  */
 /*
  * A damped least-squares (Levenberg-Marquardt) local solver of inverse kinematics on fk<n> and
@@ -10,6 +10,8 @@
  * codegen/backends/c/templates/apair.h.j2).
  */
 #include "apair_ik_internal.h"
+
+#define LOCAL_NMAX 7 /* the most joints of a chain for the local solver (NMAX, 6, is the trackers') */
 
 #define LOCAL_INV_MAX 1024
 
@@ -22,7 +24,7 @@ typedef struct {
 /* fk(q) (4 x 4) and, if J, the geometric Jacobian (6 x n); -1 outside a pair's range. */
 static int chain_eval(const local_kernels *lk, const apair_ik_chain *ch, const double *q, double *T, double *J)
 {
-    double law[NMAX * 5];
+    double law[LOCAL_NMAX * 5];
     for (int i = 0; i < ch->n; i++) {
         const double *in[3] = {q + i, ch->pair + 2 * i, ch->pair + 2 * i + 1};
         double *out[1] = {law + 5 * i};
@@ -63,10 +65,11 @@ int apair_ik_local(const apair_ik_chain *ch, size_t count, const double *target,
                    const double *seed, ptrdiff_t seed_stride, double tol, int max_iter, double *q, double *residual,
                    int *converged)
 {
-    static const char *fks[NMAX] = {"fk1", "fk2", "fk3", "fk4", "fk5", "fk6"};
-    static const char *jacs[NMAX] = {"jacobian1", "jacobian2", "jacobian3", "jacobian4", "jacobian5", "jacobian6"};
+    static const char *fks[LOCAL_NMAX] = {"fk1", "fk2", "fk3", "fk4", "fk5", "fk6", "fk7"};
+    static const char *jacs[LOCAL_NMAX] = {"jacobian1", "jacobian2", "jacobian3", "jacobian4", "jacobian5", "jacobian6",
+                                              "jacobian7"};
     int n = ch->n;
-    if (n < 1 || n > NMAX) return -1;
+    if (n < 1 || n > LOCAL_NMAX) return -1;
     local_kernels lk;
     lk.fk = apair_find_kernel(fks[n - 1]);
     lk.jac = apair_find_kernel(jacs[n - 1]);
@@ -86,7 +89,7 @@ int apair_ik_local(const apair_ik_chain *ch, size_t count, const double *target,
     for (size_t j = 0; j < count; j++) {
         const double *Tt = target + (ptrdiff_t)j * target_stride;
         double *x = q + j * n;
-        double T[16], J[6 * NMAX], e[6], trial[NMAX], eT[6];
+        double T[16], J[6 * LOCAL_NMAX], e[6], trial[LOCAL_NMAX], eT[6];
         for (int i = 0; i < n; i++) x[i] = fmin(fmax(seed[(ptrdiff_t)j * seed_stride + i], ch->lower[i]), ch->upper[i]);
         converged[j] = 0;
         residual[j] = INFINITY;
@@ -94,7 +97,7 @@ int apair_ik_local(const apair_ik_chain *ch, size_t count, const double *target,
         double err = pose_error(T, Tt, ch->scale, e), cost = sq(e), lambda = 1e-3;
         for (int it = 0; it < max_iter && err > tol; it++) {
             /* (J^T J + lambda diag(J^T J) + lambda 1e-9) dq = J^T e, J with its v rows in units of scale */
-            double A[NMAX * NMAX], g[NMAX];
+            double A[LOCAL_NMAX * LOCAL_NMAX], g[LOCAL_NMAX];
             for (int a = 0; a < n; a++) {
                 g[a] = 0.0;
                 for (int r = 0; r < 6; r++) g[a] += J[r * n + a] * (r < 3 ? 1.0 / ch->scale : 1.0) * e[r];
@@ -109,7 +112,7 @@ int apair_ik_local(const apair_ik_chain *ch, size_t count, const double *target,
             }
             int accepted = 0;
             for (int tries = 0; tries < 12 && !accepted; tries++) {
-                double M[NMAX * NMAX], d[NMAX];
+                double M[LOCAL_NMAX * LOCAL_NMAX], d[LOCAL_NMAX];
                 memcpy(M, A, sizeof M);
                 for (int a = 0; a < n; a++) M[a * n + a] += lambda * (A[a * n + a] + 1e-9);
                 /* Cholesky M = L L^T, then the two triangular solves */
@@ -126,7 +129,7 @@ int apair_ik_local(const apair_ik_chain *ch, size_t count, const double *target,
                 for (int a = 0; a < n; a++) { double s = g[a]; for (int k = 0; k < a; k++) s -= M[a * n + k] * d[k]; d[a] = s / M[a * n + a]; }
                 for (int a = n - 1; a >= 0; a--) { double s = d[a]; for (int k = a + 1; k < n; k++) s -= M[k * n + a] * d[k]; d[a] = s / M[a * n + a]; }
                 for (int i = 0; i < n; i++) trial[i] = fmin(fmax(x[i] + d[i], ch->lower[i]), ch->upper[i]);
-                double Tn[16], Jn[6 * NMAX];
+                double Tn[16], Jn[6 * LOCAL_NMAX];
                 if (chain_eval(&lk, ch, trial, Tn, Jn) == 0) {
                     double errn = pose_error(Tn, Tt, ch->scale, eT), costn = sq(eT);
                     if (costn < cost || errn < err) {

@@ -78,6 +78,7 @@ class AChain:
     def name(self, value: str) -> None:
         self._name = V.text("name", value)
 
+    _ik: Solver | None = None  # the solver, made by the first ik (dropped when pickled)
     _local_ik: Any = None  # ik_local's native fast path (apair._native.LocalIK), set up by its first call
 
     def __init__(
@@ -590,10 +591,15 @@ class AChain:
         (k = n) or, exactly, into the DH constants of its neighbours (`apair.hold`): a chain of n − len(fix)
         joints, solved as above; q (k, n) has q[:, k − 1] = value and `error` is measured on this
         chain. Refused (one line) where joints k − 1 and k + 1 are nearly parallel at that value.
-        full=True returns an `apair.ik.Solution`: q, error, candidates, complex_count, `inside`
-        (whether each solution is within `limits`) and `certified` (False where the elimination
-        degenerated and a local search supplied the solutions, or, for n = 5, 6, the start set's
-        count was not reproduced or a path was lost: the set may be incomplete) and `method`.
+        full=True returns an `apair.ik.Solution` with the same q: error, candidates, complex_count
+        (the solutions over the complex numbers), `inside` (whether each solution is within
+        `limits`), `certified` (the set is proven complete, an empty one included; False where it
+        may be incomplete: a local search supplied the solutions (n ≤ 4), or the start set or the
+        paths did not account for every solution (n = 5, 6)), `method` ("elimination", "homotopy",
+        "local search" or "reach bound") and `note` (why it is not certified, or how it was at a
+        singular pose). It costs about twice the plain answer for n ≤ 4 and nothing more for n = 5, 6,
+        but at a pose beyond the reach bound, which the plain answer settles without solving and the
+        full one still solves to count the complex solutions.
         """
         from .ik import Solver
 

@@ -13,6 +13,11 @@
 #define INV_RES APAIR_IK_RESIDUAL6_INVARIANTS
 #define WIDE_STEP 1e-4 /* the step in tau below which a stall while tracking may turn extended precision on */
 #define FAR 4.0 /* |Im theta| beyond which Newton's rounding floor in double may exceed the tracking tolerance */
+#define ENDGAME 0.5       /* tau from which the endgame watches for a path to infinity (see to_infinity) */
+#define ENDGAME_FAR 8.0   /* |Im theta| beyond which it may end a path (apair.ik.homotopy.tracker.ENDGAME_FAR) */
+#define ENDGAME_RATIO 0.8 /* the most a path to infinity's slope may shrink from one sample to the next */
+#define ENDGAME_SLOPE 0.1 /* the least outward slope of the farthest angle (per unit of log(1 - tau)) */
+#define LN2 0.6931471805599453
 
 /* Solves A X = B for complex A and B (see GAUSS_SOLVE). */
 GAUSS_SOLVE(csolve_m, cplx, cabs)
@@ -280,14 +285,73 @@ static int regular_far(const tracker *tr, const apair_ik_options *opt, const cpl
     return d <= opt->final_tol * size && cnorm(n, e) <= 1e-10 * size;
 }
 
+/* The endgame's samples of one path: the last one (L = log(1 - tau), the angles) and the slope
+ * over the interval that ended there. */
+typedef struct {
+    int samples;
+    double L;
+    cplx v[NMAX], beta[NMAX];
+} endgame;
+
+/* Whether the path is going to infinity (an endgame in L = log(1 - tau), from tau >= ENDGAME). Near
+ * the end of a path each exp(i theta / 2) has a Puiseux series in 1 - tau: on a path to infinity
+ * theta is asymptotically affine in L (theta = alpha + beta L, beta a rational multiple of i), while
+ * on a path to a finite point the slope dtheta/dL tends to 0 in a fixed direction, by 2^(-1/c) per
+ * halving of 1 - tau (c its cycle number). A sample is taken each time L has dropped by ln 2, and
+ * the slope of the farthest angle theta_j since the last one, beta, compared with the one before,
+ * beta0. Going to infinity: theta_j moves outward (|Im theta_j| grows) at ENDGAME_SLOPE or more, in
+ * the same direction (|beta - beta0| <= |beta| / 2), neither that motion nor |beta| shrank by more
+ * than r = ENDGAME_RATIO (a path to a finite point passes only before its series governs it, or
+ * with c >= 4), and |Im theta_j| exceeds ENDGAME_FAR and |beta| ln 2 r / (1 - r), the most a slope
+ * shrinking by r per halving could still move it. Such a path ends at infinity or at a finite point
+ * farther out, which double precision cannot tell apart: apair.ik.homotopy.endpoints takes the
+ * paths of a pose that end beyond ENDGAME_FAR alike, none of them real. The angles only (not the
+ * slice system's lambda). */
+static int to_infinity(endgame *eg, const tracker *tr, const cplx *v, double tau)
+{
+    int n = tr->pb->n;
+    if (tau < ENDGAME || tau >= 1.0) return 0;
+    double L = log1p(-tau);
+    if (eg->samples && eg->L - L < LN2) return 0;
+    int verdict = 0;
+    if (eg->samples) {
+        cplx beta[NMAX];
+        double far = -1.0;
+        int j = 0;
+        for (int i = 0; i < n; i++) {
+            beta[i] = (v[i] - eg->v[i]) / (L - eg->L);
+            if (fabs(cimag(v[i])) > far) { far = fabs(cimag(v[i])); j = i; }
+        }
+        if (eg->samples >= 2 && far > ENDGAME_FAR) {
+            double sign = cimag(v[j]) > 0 ? -1.0 : 1.0; /* outward: |Im theta_j| grows as L drops */
+            double out = sign * cimag(beta[j]), out0 = sign * cimag(eg->beta[j]), size = cabs(beta[j]);
+            double reach = size * LN2 * ENDGAME_RATIO / (1.0 - ENDGAME_RATIO);
+            verdict = out >= ENDGAME_SLOPE && out >= ENDGAME_RATIO * out0 && cabs(beta[j] - eg->beta[j]) <= 0.5 * size &&
+                      size >= ENDGAME_RATIO * cabs(eg->beta[j]) && far > reach;
+        }
+        memcpy(eg->beta, beta, n * sizeof(cplx));
+    }
+    eg->L = L;
+    memcpy(eg->v, v, n * sizeof(cplx));
+    eg->samples++;
+    return verdict;
+}
+
 /* One path from tau = 0 to 1: RK4 predictor, Newton corrector, step size halved on failure and
  * grown after successes; at tau = 1 Newton to full accuracy. A step costs four evaluations plus
- * the corrector's: its first stage is the last corrector iteration's tangent. */
+ * the corrector's: its first stage is the last corrector iteration's tangent. Where far-out
+ * endpoints are of no interest (wide_end infinite: the paths of one pose, never refined there), a
+ * path found going to infinity (to_infinity) ends DIVERGED long before |Im theta| reaches
+ * `divergence`, where each step needs extended precision; the start sets and the trace test, whose
+ * endpoints are all finite, are tracked without it. */
 static int track_path(const tracker *tr, const apair_ik_options *opt, cplx *v, int *steps, double *cond)
 {
     int n = tr->nv;
     double tau = 0.0, h = opt->initial_step, last = 0.0;
     int good = 0, have_k1 = 0, wide = 0, wide_steps = 0;
+    endgame eg;
+    eg.samples = 0;
+    int endgame_on = !(opt->wide_end < INFINITY);
     cplx k1[NV];  /* dv/dtau at (v, tau): kept across a failed step, taken from the corrector after one */
     *steps = 0;
     *cond = INFINITY;
@@ -316,7 +380,7 @@ static int track_path(const tracker *tr, const apair_ik_options *opt, cplx *v, i
             memcpy(k1, knext, n * sizeof(cplx));  /* the next step's first stage, from the corrector */
             tau = (hh == 1.0 - tau) ? 1.0 : tau + hh;
             if (++good >= 2) { h = fmin(2.0 * h, opt->max_step); good = 0; }
-            if (far > opt->divergence) return APAIR_PATH_DIVERGED;
+            if (far > opt->divergence || (endgame_on && to_infinity(&eg, tr, v, tau))) return APAIR_PATH_DIVERGED;
         } else {
             h *= 0.5;
             good = 0;

@@ -255,14 +255,14 @@ def test_paths_to_infinity_count_only_once_new_gammas_confirm_them(monkeypatch):
     assert ends.complete and len(ends.theta) == 7 and ends.diverged == 1 and ends.failed == 0
 
 
-def test_paths_that_never_end_leave_the_set_uncertified():
+def test_paths_that_all_go_to_infinity_leave_a_certified_empty_set():
     """A pose out of reach whose solutions all lie at infinity (the UR5's wrist centre on axis 1,
-    d4 ≠ 0): no path ends, nothing is proven, and the empty set is not certified."""
+    d4 ≠ 0): every path is found going to infinity, with every new γ, and the empty set is certified."""
     arm = chain("UR5")
     T = np.eye(4)
     T[:3, 3] = [0.0, 0.0, 0.3 + 0.0823]  # the wrist centre at (0, 0, 0.3)
     sol = arm.ik(T, full=True)
-    assert len(sol.q) == 0 and not sol.certified
+    assert len(sol.q) == 0 and sol.certified and not Oracles("UR5").solutions(T)
 
 
 @pytest.mark.parametrize("name", list(ARMS))

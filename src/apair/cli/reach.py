@@ -36,14 +36,22 @@ def _cmd_ik(args: argparse.Namespace) -> int:
         return 0 if nearest is None else 1
     with text_numbers():
         if nearest is not None:
-            why = "" if sol.certified else " (not certified complete)"
+            why = (
+                ""
+                if sol.certified
+                else f" (not certified complete: {sol.note})"
+                if sol.note
+                else " (not certified complete)"
+            )
             print(
                 f"{chain.name}: the pose is unreachable{why}. The nearest pose found inside the joint limits "
                 f"(q = {nearest.q} rad) is {nearest.position:.3e} m and {nearest.rotation:.3e} rad away "
                 f"(distance {nearest.distance:.3e}, one radian weighing as {nearest.scale:.3g} m)."
             )
             return 1
-        complete = "" if sol.certified else "; not certified complete"
+        complete = (
+            "" if sol.certified else f"; not certified complete: {sol.note}" if sol.note else "; not certified complete"
+        )
         count = f" of {sol.complex_count} complex" if sol.complex_count is not None else ""
         print(
             f"{chain.name}: {len(sol.q)} real solution(s){count}, by {sol.method}{complete}; angles in rad"
@@ -77,6 +85,7 @@ def _ik_document(
         "complex_count": sol.complex_count,
         "method": sol.method,
         "certified": sol.certified,
+        "note": sol.note,
     }
     if nearest is not None:
         doc["nearest"] = {

@@ -39,10 +39,17 @@ degenerate, and each has its own remedy:
 - joints 1 and 2 on one axis (a_1 = α_1 = 0): u_1 and u_2 come together from a bivariate
   system (`_solve_coaxial`);
 - what still degenerates is solved on the reversed chain (K_n·T̃ = Π P̃ K̃, the halves swapped);
-  where both orientations fail (or find nothing for a pose within reach), a batched
-  Levenberg-Marquardt search from 64 seeds finds the solutions, and the answer says that it is
-  not certified complete (`Solution.certified`; apair.ik.solver, apair.ik.local). A curve of
-  solutions (two R-pairs on one axis) is refused with a ValueError.
+  where both orientations fail, a batched Levenberg-Marquardt search from 64 seeds finds the
+  solutions, and the answer says that it is not certified complete (`Solution.certified`;
+  apair.ik.solver, apair.ik.local); where they find nothing for a pose within reach, the search
+  checks that "none", which stands (certified) unless it finds a solution. A curve of solutions
+  (two R-pairs on one axis) is refused with a ValueError.
+
+Counting the complex solutions (`full=True`) keeps the real path as it is and adds the complex
+roots u_3 with Im u_3 >= 0 (the pose is real: the others give the conjugates), screened as the
+real ones are (`_complex_pairs`); most of their images are proven to have no left-half solution
+by one singular value each (apair.ik.pencil.no_common_root), so the count costs about as much as
+the real answer.
 
 Every real candidate is checked with the chain's own fk kernel, refined by up to two Gauss-Newton
 steps where it is not already accurate to 1e-3·tol, and kept only if fk(q) reproduces T to `tol`
@@ -60,6 +67,8 @@ apair.ik.elimination1a5r or by parameter homotopy (apair.ik.homotopy), and `ik_l
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 
 from ..kernels import native_in_use
@@ -68,6 +77,7 @@ from .joints import chain_joints, curve_minors, evaluate, left_matrix, on_curve,
 from .pencil import (
     DEFLATE_TOL,
     LEAD_COND,
+    NO_ROOT,
     PROBE,
     ROOT_RTOL,
     Degenerate,
@@ -79,6 +89,7 @@ from .pencil import (
     hidden_variable,
     isotropic_factors,
     isotropic_quotient,
+    no_common_root,
     null_vectors,
     polished,
     product_map,
@@ -90,6 +101,7 @@ from .pencil import (
 )
 from .poses import wrap
 
+_Pair = tuple[np.ndarray, np.ndarray] | None  # the two images eliminated (None: a singular pencil's regular part)
 OUTSIDE = [1, 2, 5, 6]  # components that vanish on the pair subalgebra
 INSIDE = [0, 3, 4, 7]  # the subalgebra's components: 1, k, ε, εk
 REAL_TOL = 1e-6  # |Im u| / (1 + |u|) under which a root is taken as real
@@ -97,9 +109,8 @@ CAND_TOL = 1e-4  # the same for an intermediate root (multiple roots lose half t
 SCREEN_TOL = (1e-8, 1e-8, 1e-6)  # the screen: Vandermonde null vector; accept; reject (see _screen)
 _SCREEN_TOL = np.array(SCREEN_TOL)
 # apair_ik4_left: ROOT_RTOL; a single null vector's rank gap; its Vandermonde test; no root at all
-# (the smallest singular value above 1e-4 of the largest; a root of relative residual ROOT_RTOL
-# bounds it by ROOT_RTOL·√(rows·cols) ≤ 1.2e-5 of it for the at most 16 × 8 matrices)
-LEFT_TOL = np.array([ROOT_RTOL, 1e-6, 1e-8, 1e-4])
+# (NO_ROOT, as unique_roots)
+LEFT_TOL = np.array([ROOT_RTOL, 1e-6, 1e-8, NO_ROOT])
 
 
 class Elimination:
@@ -188,7 +199,9 @@ class Elimination:
         solution of a real W in C (apair_ik4_left, the first step of _solve_left_general) where
         the kernels are installed, every other row by _solve_left_general."""
         native = native_in_use()
-        if native is None or len(Ws) == 0 or np.iscomplexobj(Ws):
+        if np.iscomplexobj(Ws) and len(Ws):
+            return self._solve_left_complex(Ws)
+        if native is None or len(Ws) == 0:
             return self._solve_left_general(Ws)
         j2 = self.joints[1]
         joint = np.array([j2.kind == "revolute", j2.delta, j2.offset, j2.sign], float)
@@ -196,6 +209,20 @@ class Elimination:
         out = [[np.array([x, y]) for y, good in zip(ys, oks) if good] for x, ys, oks in zip(u1, u2, ok)]
         rest = np.flatnonzero(status == 1)  # 2: no root u_1 at all
         for r, sols in zip(rest, self._solve_left_general(Ws[rest])):
+            out[r] = sols
+        return out
+
+    def _solve_left_complex(self, Ws: np.ndarray) -> list[list[np.ndarray]]:
+        """_solve_left_general for complex rows (the count of the complex solutions), the rows
+        proven to have no root u_1 at all (no_common_root, as _solve_left_general's test, which
+        does not apply where joints 1 and 2 share an axis) first left out: most of them, there."""
+        Zc = np.einsum("mab,rb->rma", self.Zmap, Ws)
+        outside = Zc[:, :, OUTSIDE]
+        coaxial = np.abs(outside).max(axis=(1, 2)) <= 1e-10 * np.abs(Zc).max(axis=(1, 2))
+        polys = np.swapaxes(outside, 1, 2)
+        rows = np.flatnonzero(coaxial | ~no_common_root(shifted(polys, polys.shape[2] - 2)))
+        out: list[list[np.ndarray]] = [[] for _ in range(len(Ws))]
+        for r, sols in zip(rows, self._solve_left_general(Ws[rows]) if len(rows) else []):
             out[r] = sols
         return out
 
@@ -211,8 +238,9 @@ class Elimination:
         rows = np.flatnonzero(~coaxial)
         # the usual case, one (u_1, u_2) per W, from two null vectors; the rest by eigenvalues
         polys = np.swapaxes(outside[rows], 1, 2)  # (R, 4, D1+1)
-        u1, one = unique_roots(shifted(polys, polys.shape[2] - 2))  # as apair_ik4_left does
+        M = shifted(polys, polys.shape[2] - 2)
         if not np.iscomplexobj(Ws):
+            u1, one, none = unique_roots(M)  # as apair_ik4_left does
             Z = np.einsum("km,kma->ka", u1[:, None] ** np.arange(Zc.shape[1]), Zc[rows])
             u2 = self.joints[1].parameters_of(Z)  # (R, 1 or 2), each tested
             ok = np.stack(
@@ -225,9 +253,11 @@ class Elimination:
             one &= ok.any(axis=1)
             for r, x, ys, oks in zip(rows[one], u1[one], u2[one], ok[one]):
                 out[r] = [np.array([x, y]) for y, good in zip(ys, oks) if good]
-        else:
-            one[:] = False
-        rows = rows[~one]
+        else:  # (complex W: for the count of complex solutions, most with no root u_1 at all)
+            one, none = np.zeros(len(rows), bool), no_common_root(M)
+        rows = rows[~one & ~none]
+        if len(rows) == 0:
+            return out
         u1s = common_roots_many(np.swapaxes(outside[rows], 1, 2), self.rng)
         if any(u is None for u in u1s):
             raise Degenerate("every polynomial vanishes identically")
@@ -394,10 +424,10 @@ class Elimination:
 
     def _on_quadrics(self, u3: np.ndarray, u4: np.ndarray, C: np.ndarray):
         """The images W(u_3, u_4) (r, 8) and the left half's largest quadric on each, relative to |W|²."""
-        W = np.einsum("ri,ija->rja", u3[:, None] ** np.arange(C.shape[0]), C)
-        W = np.einsum("rj,rja->ra", u4[:, None] ** np.arange(C.shape[1]), W)
-        rel = np.abs(np.einsum("ra,kab,rb->rk", W, self.Q, W)).max(axis=1) / np.maximum(np.sum(W * W, axis=1), 1e-300)
-        return W, rel
+        Cu = (u3[:, None] ** np.arange(C.shape[0]) @ C.reshape(C.shape[0], -1)).reshape(len(u3), C.shape[1], 8)
+        W = (u4[:, None, None] ** np.arange(C.shape[1])[None, None, :] @ Cu)[:, 0]
+        size = np.maximum(np.sum(np.abs(W) ** 2, axis=1), 1e-300)
+        return W, np.abs(np.sum((W @ self.Q) * W, axis=-1)).max(axis=0) / size
 
     def _right_pairs(self, u3s: np.ndarray, C: np.ndarray, real: bool) -> tuple[np.ndarray, np.ndarray]:
         """For each u_3, the u_4 where every quadric of the left half vanishes on W(u_3, u_4) (their
@@ -438,28 +468,90 @@ class Elimination:
             images = [(r[0] ** np.arange(len(C))) @ C for r in rights]
         else:
             u3s, pair = self._resultant_roots(C)
+            rights, images = _with_cluster_means(*self._real_pairs(u3s, pair, C), C)
             if count_complex:
-                rights, images = self._right_pairs(_with_means(u3s), C, real=False)
-            else:
-                # a mean within CAND_TOL of the real axis has both roots within 2·CAND_TOL of it
-                u3s = _with_means(u3s[np.abs(u3s.imag) <= 2 * CAND_TOL * (1 + np.abs(u3s))])
-                u3s = u3s[np.abs(u3s.imag) <= CAND_TOL * (1 + np.abs(u3s))].real
-                rights, images, rest = self._screen(u3s, pair, C)
-                if len(rest):
-                    more, more_images = self._right_pairs(rest, C, real=True)
-                    rights, images = np.concatenate([rights, more]), np.concatenate([images, more_images])
-            rights, images = _with_cluster_means(rights, images, C)
+                more = self._with_left(*_with_cluster_means(*self._complex_pairs(u3s, pair, C), C))
+                mirrored = [v.conj() for v in more if v[2].imag > CAND_TOL * (1 + abs(v[2]))]
+                return self._with_left(rights, images) + more + mirrored
+        return self._with_left(rights, images)
+
+    def _with_left(self, rights, images) -> list[np.ndarray]:
+        """The parameter vectors (u_1, u_2, right…) of the left half solved for each image."""
         out = []
         for right, lefts in zip(rights, self._solve_left_many(np.asarray(images).reshape(-1, 8))):
             out += [np.concatenate([left, right]) for left in lefts]
         return out
 
+    def _real_pairs(self, u3s: np.ndarray, pair: _Pair, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The real pairs (u_3, u_4) of 4 joints and their images: the real roots u_3 (and the mean
+        of every two close ones) screened (`_screen`), the undecided by `_right_pairs`."""
+        # a mean within CAND_TOL of the real axis has both roots within 2·CAND_TOL of it
+        u3s = _with_means(u3s[np.abs(u3s.imag) <= 2 * CAND_TOL * (1 + np.abs(u3s))])
+        u3s = u3s[np.abs(u3s.imag) <= CAND_TOL * (1 + np.abs(u3s))].real
+        rights, images, rest = self._screen(u3s, pair, C)
+        if len(rest):
+            more, more_images = self._right_pairs(rest, C, real=True)
+            rights, images = np.concatenate([rights, more]), np.concatenate([images, more_images])
+        return rights, images
+
+    def _complex_pairs(self, u3s: np.ndarray, pair: _Pair, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The pairs (u_3, u_4), not both real, on whose image every quadric of the left half
+        vanishes, and their images (r, 8), complex: what the count of the complex solutions adds
+        to `_real_pairs`. Every root u_3 off the isotropic points is screened as `_screen` screens
+        the real ones, in complex arithmetic: a Vandermonde null vector of the eliminated pair's
+        Sylvester matrix gives its one common root u_4, which the quadrics accept or reject; the
+        rest (two or more roots u_4, but for a real u_3 with two real ones, or a residual in
+        between) get the common roots of all quadrics (`_right_pairs`). Isotropic pairs are
+        dropped. The pose is real, so the solutions at the conjugate of a root u_3 are the
+        conjugates of those at u_3: only the roots with Im u_3 >= 0 (to CAND_TOL) are taken, and the
+        caller adds the conjugates (and the means of close pairs, for a double root's accuracy)."""
+        u3s = u3s[~_isotropic(u3s) & (u3s.imag >= -CAND_TOL * (1 + np.abs(u3s)))].astype(complex)
+        rest = u3s
+        pairs, images = np.zeros((0, 2), complex), np.zeros((0, 8), complex)
+        if pair is not None and len(u3s):
+            x = null_vectors(sylvester_at(*pair, u3s))
+            solved = np.isfinite(x).all(axis=1)
+            x = np.where(solved[:, None], x, 0)
+            u4 = np.sum(x[:, :-1].conj() * x[:, 1:], axis=1) / np.maximum(
+                np.sum(np.abs(x[:, :-1]) ** 2, axis=1), 1e-300
+            )
+            vandermonde = solved & (np.linalg.norm(x[:, 1:] - u4[:, None] * x[:, :-1], axis=1) <= SCREEN_TOL[0])
+            W, rel = self._on_quadrics(u3s, u4, C)
+            accept = vandermonde & (rel <= SCREEN_TOL[1])
+            pairs, images = np.stack([u3s[accept], u4[accept]], 1), W[accept]
+            undecided = ~accept & ~(vandermonde & ~(rel <= SCREEN_TOL[2]))
+            # a real u_3 whose two roots u_4 are real (an A-pair's θ and θ + 2π) is _real_pairs' alone
+            rows = np.flatnonzero(undecided & ~vandermonde & (np.abs(u3s.imag) <= CAND_TOL * (1 + np.abs(u3s))))
+            if len(rows):
+                two = two_roots(sylvester_at(*pair, u3s[rows].real))
+                undecided[rows[np.all(np.abs(two.imag) <= CAND_TOL * (1 + np.abs(two)), axis=1)]] = False
+            rest = u3s[undecided]
+        if len(rest):
+            more, more_images = self._right_pairs(rest, C, real=False)
+            pairs, images = np.concatenate([pairs, more]), np.concatenate([images, more_images])
+        real = np.all(np.abs(pairs.imag) <= CAND_TOL * (1 + np.abs(pairs)), axis=1)
+        keep = ~real & ~_isotropic(pairs[:, 1])
+        return pairs[keep], images[keep]
+
 
 # ----------------------------------------------------------------------------- helpers
+def _isotropic(u: np.ndarray) -> np.ndarray:
+    """Where a parameter is at an isotropic point u = ±i (a joint's rotation part vanishes: never a
+    displacement), to the tolerance apair.ik.solver drops such candidates with."""
+    return np.abs(1 + u * u) <= 1e-3 * (1 + np.abs(u) ** 2)
+
+
 def _close_pairs(x: np.ndarray) -> tuple[np.ndarray, ...]:
     """Indices i < j of the rows of x (r, m) that agree to CAND_TOL in every entry."""
-    close = np.all(np.abs(x[:, None] - x[None]) <= CAND_TOL * (1 + np.abs(x[:, None])), axis=-1)
-    return np.nonzero(np.triu(close, 1))
+    i, j = _upper(len(x))
+    close = np.all(np.abs(x[i] - x[j]) <= CAND_TOL * (1 + np.abs(x[i])), axis=-1)
+    return i[close], j[close]
+
+
+@cache
+def _upper(r: int) -> tuple[np.ndarray, np.ndarray]:
+    """The index pairs i < j of r rows, row by row."""
+    return np.triu_indices(r, 1)
 
 
 def _with_means(u: np.ndarray) -> np.ndarray:

@@ -32,6 +32,10 @@ from scipy.linalg import lapack
 
 SEED = 46  # fixed: the parameter shifts and random combinations are reproducible
 ROOT_RTOL = 1e-6  # relative residual under which a root is a candidate (verification decides)
+# the smallest singular value of a system's shifted coefficient matrix (at most 16 × 8) above which,
+# relative to the largest, it has no common root: a root of relative residual ROOT_RTOL bounds it by
+# ROOT_RTOL·√(rows·cols) ≤ 1.2e-5 (`unique_roots`, apair_ik4_left)
+NO_ROOT = 1e-4
 LEAD_COND = 1e10  # 1-norm condition number of the Sylvester rows' leading coefficients under which
 #                  the hidden-variable pencil is taken as regular and solved as B⁻¹A
 DEFLATE_TOL = 1e-10  # relative residual of g(±i, ·) = f(±i, ·)·h under which g is deflated (`deflate`)
@@ -102,20 +106,36 @@ def shifted(polys: np.ndarray, m: int) -> np.ndarray:
     return out.reshape(R, (m + 1) * k, d + m)
 
 
-def unique_roots(M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """For systems M (R, k, D+1) of polynomials (ascending coefficients): (u (R,), ok (R,)), ok
-    where the coefficient matrix has rank D and its null vector is (1, u, …, u^D) of a root that
-    passes the residual test. A common root puts its vector in the null space, so ok means
-    exactly one common root (the others go to the eigenvalues: common_roots_many)."""
+def unique_roots(M: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For systems M (R, k, D+1) of polynomials (ascending coefficients): (u (R,), ok (R,), none
+    (R,)), ok where the coefficient matrix has rank D and its null vector is (1, u, …, u^D) of a
+    root that passes the residual test. A common root puts its vector in the null space, so ok
+    means exactly one common root (the others go to the eigenvalues: common_roots_many), and none
+    (the smallest singular value above NO_ROOT of the largest) that there is no common root."""
     D = M.shape[2] - 1
     if len(M) == 0 or D < 1 or M.shape[1] < D:
-        return np.zeros(len(M), M.dtype), np.zeros(len(M), bool)
-    _, sv, Vt = np.linalg.svd(M)
+        return np.zeros(len(M), M.dtype), np.zeros(len(M), bool), np.zeros(len(M), bool)
+    _, sv, Vt = np.linalg.svd(M, full_matrices=False)
     v = Vt[:, -1].conj()
     u = np.sum(v[:, :-1].conj() * v[:, 1:], axis=1) / np.maximum(np.sum(np.abs(v[:, :-1]) ** 2, axis=1), 1e-300)
     vandermonde = np.linalg.norm(v[:, 1:] - u[:, None] * v[:, :-1], axis=1) <= 1e-8
     ok = (sv[:, D - 1] > 1e-6 * sv[:, 0]) & vandermonde & (relres_many(M, u) <= ROOT_RTOL)
-    return u, ok
+    return u, ok, _rootless(M, sv)
+
+
+def no_common_root(M: np.ndarray) -> np.ndarray:
+    """(R,) for systems M (R, k, D+1) as in unique_roots: where they have no common root (the
+    singular values from the eigenvalues of M^H M, which take a third of an SVD's time)."""
+    if len(M) == 0 or M.shape[1] <= M.shape[2] - 1:
+        return np.zeros(len(M), bool)
+    lam = np.linalg.eigvalsh(np.swapaxes(M.conj(), 1, 2) @ M)  # ascending
+    return _rootless(M, np.sqrt(np.maximum(lam[:, ::-1], 0.0)))
+
+
+def _rootless(M: np.ndarray, sv: np.ndarray) -> np.ndarray:
+    """No common root: the smallest singular value above NO_ROOT of the largest (a common root
+    puts its vector (1, u, …, u^D) in the null space)."""
+    return (M.shape[1] > M.shape[2] - 1) & (sv[:, -1] > NO_ROOT * sv[:, 0])
 
 
 def relres_many(M: np.ndarray, u: np.ndarray) -> np.ndarray:

@@ -3,8 +3,9 @@ method by the chain's shape. 1 to 4 joints: the elimination by kinematic mapping
 (apair.ik.elimination4), on the chain as given, else on the reversed chain, else a local search
 (apair.ik.local) whose answer is not certified complete; 5 and 6 joints: the 6R elimination
 (apair.ik.elimination6r), the one-A-pair elimination (apair.ik.elimination1a5r), else parameter
-homotopy from the design's start system (apair.ik.homotopy). Every real candidate is verified and
-refined by apair.ik.poses.refine.
+homotopy from the design's start system (apair.ik.homotopy; at a singular pose, where its paths
+do not account for every start solution, by way of a pose moved by 1e-6). Every real candidate is
+verified and refined by apair.ik.poses.refine.
 
 Every method works on the chain in units of its length scale L (apair.ik.poses.length_scale: the
 pose's translation divided by L, the design's lengths too), and the tolerances on translations
@@ -45,12 +46,14 @@ if TYPE_CHECKING:
 class Solution:
     """All real solutions `q` (k, n) of one pose, with the counts behind them.
 
-    complex_count: solutions over the complex numbers found by the elimination (None unless
-    asked for); candidates: real candidates examined; error: fk error of each solution;
-    certified: False when the elimination degenerated (or found nothing) at this pose and the
-    solutions come from the local fallback search, so that the set may be incomplete; method: how
-    the set was found ("reach bound": the pose's position lies beyond Σ |a| + |c| + 2h from the
-    base, so no joint vector reaches it)."""
+    complex_count: solutions over the complex numbers found by the elimination or the homotopy
+    (None unless asked for); candidates: real candidates examined; error: fk error of each
+    solution; certified: the set is proven complete (an empty one: the pose is unreachable), to
+    the solvers' tolerances; False where it may be incomplete: the local fallback search's answer
+    (n ≤ 4), or a start set or paths that do not account for every solution (n = 5, 6); method:
+    how the set was found ("reach bound": the pose's position lies beyond Σ |a| + |c| + 2h from
+    the base, so no joint vector reaches it); note: why it is not certified, or how it was where
+    the method alone did not (a singular pose certified by a pose moved by 1e-6), else empty."""
 
     q: NDArray[np.float64]
     error: NDArray[np.float64]
@@ -59,6 +62,7 @@ class Solution:
     certified: bool = True
     inside: NDArray[np.bool_] | None = None  # (k,) within the chain's joint limits (set by AChain.ik)
     method: str = "elimination"  # or "homotopy" (n = 5, 6), "local search" (the fallback), "reach bound"
+    note: str = ""  # why the set is not certified, or how it was where not by the method alone
 
 
 FAR = 1e6  # beyond FAR times the reach bound a pose is answered by the bound even when complex
@@ -97,7 +101,9 @@ class Solver:
 
     The elimination runs on the chain as given; where it degenerates (or finds nothing for a pose
     within reach) it runs on the reversed chain, and where that degenerates too a batched local
-    search from many seeds gives the solutions, marked as not certified complete."""
+    search from many seeds gives the solutions, marked as not certified complete. Where an
+    elimination ran to its end and found nothing, the search checks it, and that "none" stands
+    (certified) unless the search finds a solution."""
 
     def __init__(self, chain: ChainLike, seed: int = SEED) -> None:
         n = chain.n
@@ -147,7 +153,8 @@ class Solver:
         target[4:] /= self.scale
         Tm = pose.matrix
         n = self.chain.n
-        degenerate = []
+        degenerate: list[str] = []
+        none: Solution | None = None  # the first orientation that ran to its end and found no solution
         for reverse in (False, True) if n >= 2 else (False,):
             try:
                 found = self._elimination(reverse).candidates(target, count_complex)
@@ -164,17 +171,41 @@ class Solver:
             real = cands[np.all(np.abs(cands.imag) <= CAND_TOL * (1 + np.abs(cands)), axis=1)]
             q = with_twins(self.chain, self._elimination(reverse).angles(real))
             q, err = refine(self.chain, q, Tm, tol, self.scale)
-            if len(q) or not near_reach(self.chain, Tm, self.reach, self.scale):
+            if len(q):
+                self._refuse_a_curve(q, Tm, tol, "")
                 return Solution(q, err, len(real), count)
-        # every elimination degenerated, or found nothing for a pose within reach: local search
-        q, err = refine(self.chain, local_search(self.chain, Tm), Tm, tol, self.scale)
-        if len(q) and on_continuum(self.chain, q[0], Tm, tol):
-            why = f" ({degenerate[0]})" if degenerate else ""
+            if not near_reach(self.chain, Tm, self.reach, self.scale):
+                return Solution(q, err, len(real), count)
+            none = none or Solution(q, err, len(real), count)
+        return self._local(Tm, tol, none, degenerate)
+
+    def _refuse_a_curve(self, q: NDArray[np.float64], Tm: NDArray[np.float64], tol: float, why: str) -> None:
+        """A one-line refusal where the solutions found lie on a curve of solutions (a rank-deficient
+        Jacobian at every one of them and a step along its null space landing on another: e.g.
+        joints on one axis, a self-motion): the elimination's isolated points would be a sample."""
+        if np.all(jacobian_rank(self.chain, q, self.scale) < self.chain.n) and on_continuum(self.chain, q[0], Tm, tol):
             raise ValueError(
                 f"T: the solutions at this pose are not isolated{why}: they form a curve (e.g. two R-pairs on one axis)"
             )
-        certified = len(q) == 0 and not degenerate  # the elimination's "none" stands
-        return Solution(q, err, 0, None, certified=certified, method="local search")
+
+    def _local(self, Tm: NDArray[np.float64], tol: float, none: Solution | None, degenerate: list[str]) -> Solution:
+        """n ≤ 4 where every orientation degenerated, or found nothing for a pose within reach: a
+        local search from many seeds. Where it finds nothing either, an elimination's "none" stands
+        (`none`: method "elimination", certified: no real solution within its tolerances); where
+        it finds solutions, they are the answer, not certified complete."""
+        q, err = refine(self.chain, local_search(self.chain, Tm), Tm, tol, self.scale)
+        why = f" ({degenerate[0]})" if degenerate else ""
+        if len(q) and on_continuum(self.chain, q[0], Tm, tol):
+            self._refuse_a_curve(q, Tm, tol, why)
+        if len(q) == 0 and none is not None:
+            return none
+        if none is not None:
+            note = f"the elimination found no solution where a local search found {len(q)}: the set may be incomplete"
+        elif len(q):
+            note = f"the elimination degenerated at this pose{why}: the solutions come from a local search"
+        else:
+            note = f"the elimination degenerated at this pose{why}, and a local search found no solution"
+        return Solution(q, err, 0, None, certified=False, method="local search", note=note)
 
     def _solve_homotopy(self, pose: Pose, tol: float) -> Solution:
         """n = 5, 6: R-chains by the 6R elimination (apair.ik.elimination6r) where it certifies its
@@ -191,17 +222,39 @@ class Solver:
         for route in (elimination6r, elimination1a5r):
             if route.applies(problem):
                 theta = route.solve(problem, Tu)
+        note = ""
         if theta is not None:
             theta, complete, method = homotopy.own(problem, theta), True, "elimination"
         else:
-            if self._start is None:
-                self._start = homotopy.start_system(problem)
-            ends = homotopy.solve(problem, self._start, Tu)
-            theta, complete, method = ends.theta, ends.complete, "homotopy"
-            self._refuse_continuum(problem, ends, Tm, tol)
+            theta, complete, note = self._homotopy(problem, Tu, Tm, tol)
+            method = "homotopy"
         real = homotopy.real_angles(problem, theta)
         q, err = refine(self.chain, real, Tm, tol, self.scale)
-        return Solution(q, err, len(real), len(theta), certified=complete, method=method)
+        return Solution(q, err, len(real), len(theta), certified=complete, method=method, note=note)
+
+    def _homotopy(
+        self, problem: Problem, Tu: NDArray[np.float64], Tm: NDArray[np.float64], tol: float
+    ) -> tuple[NDArray[np.complex128], bool, str]:
+        """Every start solution tracked to Tu (homotopy.solve); where the paths do not account for
+        all of them but the start set is certified (a singular pose, where paths meet at a
+        multiple root), also from a pose moved by homotopy.NEAR (homotopy.solve_near), whose
+        certificate then stands for T's. (theta, complete, note: how it was certified or why not)."""
+        if self._start is None:
+            self._start = homotopy.start_system(problem)
+        start = self._start
+        ends = homotopy.solve(problem, start, Tu)
+        self._refuse_continuum(problem, ends, Tm, tol)
+        if ends.complete:
+            return ends.theta, True, ""
+        if not start.certified:
+            return ends.theta, False, f"the start set is not certified: {start.how}"
+        near = homotopy.solve_near(problem, start, Tu)
+        theta = homotopy.merged(problem, ends.theta, near.theta)
+        here = _unaccounted(ends)
+        if near.complete:
+            how = f"certified at a pose moved by {near.near:g}, its solutions carried back onto T by Newton's method"
+            return theta, True, f"{how} (at T {here})"
+        return theta, False, f"at T {here}, and at a pose moved by {near.near:g} {_unaccounted(near)}"
 
     def _refuse_continuum(self, problem: Problem, ends: Endpoints, Tm: NDArray[np.float64], tol: float) -> None:
         """ValueError where the pose has a curve of real solutions (a wrist singularity: two R-pair
@@ -219,6 +272,14 @@ class Solver:
                     "T: the solutions at this pose are not isolated: they form a curve (e.g. a wrist "
                     "singularity, two R-pair axes in line)"
                 )
+
+
+def _unaccounted(ends: Endpoints) -> str:
+    """What kept a pose's endpoints (homotopy.Endpoints) from accounting for every start solution."""
+    parts = ["paths met at a multiple root (a singular pose)"] if ends.multiple else []
+    if ends.failed or not parts:
+        parts.append(f"{ends.failed} of {ends.paths} start solutions were not accounted for")
+    return " and ".join(parts)
 
 
 def _dedupe_complex(cands: NDArray[np.complex128], tol: float = 1e-6) -> list[NDArray[np.complex128]]:

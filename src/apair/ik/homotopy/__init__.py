@@ -43,11 +43,18 @@ reaches all of it:
   reported as diverging proves nothing by itself (at a generic pose every solution is finite, and
   a path can jump off to infinity): its start is tracked again with new γ, and paths to infinity
   count only when `endpoints.CONFIRM` rounds without failures agree on them (see `solve`).
+- **Special poses** (axis-aligned rotations, the workspace's boundary, unreachable targets): per
+  pose the C tracker ends a path found going to infinity by an endgame in log(1 − τ) once it is
+  beyond |Im θ| = ENDGAME_FAR (apair_ik_track.c, to_infinity; such a path may instead end at a
+  finite point farther out, and the endpoints beyond ENDGAME_FAR are taken alike, none real).
+  Paths that meet at an ill-conditioned endpoint meet at a multiple root (a singular pose); the
+  set is then certified by the pose moved by NEAR, solved and its solutions carried back by
+  Newton (`solve_near`).
 """
 
 from __future__ import annotations
 
-from .endpoints import Endpoints, solve
+from .endpoints import NEAR, Endpoints, merged, solve, solve_near
 from .monodromy import segment
 from .problem import (
     LOOSE,
@@ -71,6 +78,7 @@ from .problem import (
 from .startsets import StartSystem, generic_count, prepare, start_system, stored_counts
 from .tracker import (
     DIVERGED,
+    ENDGAME_FAR,
     FAILED,
     OK,
     RETRIES,
@@ -88,8 +96,10 @@ from .tracker import (
 
 __all__ = [
     "DIVERGED",
+    "ENDGAME_FAR",
     "FAILED",
     "LOOSE",
+    "NEAR",
     "OK",
     "REAL",
     "RETRIES",
@@ -109,6 +119,7 @@ __all__ = [
     "generic_count",
     "law",
     "linear_pose",
+    "merged",
     "newton",
     "own",
     "own_rows",
@@ -118,6 +129,7 @@ __all__ = [
     "scale_of",
     "segment",
     "solve",
+    "solve_near",
     "start_system",
     "stored_counts",
     "system",

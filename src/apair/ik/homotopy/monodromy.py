@@ -13,6 +13,7 @@ from .tracker import DIVERGED, FAILED, OK, TOO_LONG, unit_gamma
 
 STABLE = 20  # loops in a row without a new solution that end a monodromy run
 MAX_LOOPS = 400
+SEED_DRAWS = 5  # random points in a row with a singular Jacobian before the solutions are taken as not isolated
 
 
 def lost_paths(status: np.ndarray, finite: bool) -> np.ndarray:
@@ -35,30 +36,39 @@ def segment(problem: Problem, a, b, start: np.ndarray, rng, retries: int = 2, fi
 
 
 def _seed_solution(problem: Problem, rng):
-    """A random complex joint vector and a generic pose p0 at which it is a solution."""
+    """A random complex joint vector and a generic pose p0 at which it is a regular solution. A
+    point where the Jacobian is singular is drawn again: only where SEED_DRAWS of the points drawn are
+    singular are the solutions taken as not isolated (a singular point of a generic design is a
+    chance, one of a degenerate design the rule)."""
     n = problem.n
+    singular = 0
     for _ in range(20):
         theta = rng.uniform(-np.pi, np.pi, n) + 0.3j * rng.standard_normal(n)
-        A, b = linear_pose(problem, theta)
-        # A p + b = 0: a particular solution plus a random element of the null space
-        M, rhs = A, -b
-        p, *_ = np.linalg.lstsq(M, rhs, rcond=None)
-        _, sv, Vh = np.linalg.svd(M)
-        null = Vh[len(sv[sv > 1e-10 * sv[0]]) :].conj().T
-        p = p + null @ (rng.standard_normal(null.shape[1]) + 1j * rng.standard_normal(null.shape[1]))
+        p = _pose_through(problem, theta, rng)
         F, J, _ = system(problem, theta, p, np.zeros(7, complex))
-        H, Hv = F, J
-        if np.max(np.abs(H)) > 1e-9 or np.abs(p[3:]).max() < 1e-3:
+        if np.max(np.abs(F)) > 1e-9 or np.abs(p[3:]).max() < 1e-3:
             continue
-        sv = np.linalg.svd(Hv, compute_uv=False)
-        if sv[-1] < 1e-8 * sv[0]:
+        sv = np.linalg.svd(J, compute_uv=False)
+        if not sv[-1] < 1e-8 * sv[0]:
+            return theta, p
+        singular += 1
+        if singular == SEED_DRAWS:
             raise ValueError(
                 "chain: the inverse kinematics has no isolated solutions at a generic pose (the "
-                "solutions form curves: e.g. two R-pairs on one axis, or a joint that cannot move the "
-                "end frame)"
+                f"Jacobian is singular at {SEED_DRAWS} random points: the solutions form curves, e.g. two "
+                "R-pairs on one axis, or a joint that cannot move the end frame)"
             )
-        return theta, p
     raise RuntimeError("homotopy: no regular starting solution found")
+
+
+def _pose_through(problem: Problem, theta: np.ndarray, rng) -> np.ndarray:
+    """A random pose p with F(θ; p) = 0: A p + b = 0 (F is linear in the pose) by a particular
+    solution plus a random element of the null space."""
+    A, b = linear_pose(problem, theta)
+    p, *_ = np.linalg.lstsq(A, -b, rcond=None)
+    _, sv, Vh = np.linalg.svd(A)
+    null = Vh[len(sv[sv > 1e-10 * sv[0]]) :].conj().T
+    return np.asarray(p + null @ (rng.standard_normal(null.shape[1]) + 1j * rng.standard_normal(null.shape[1])))
 
 
 def monodromy(

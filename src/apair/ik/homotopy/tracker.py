@@ -22,6 +22,11 @@ OK, SINGULAR, FAILED, DIVERGED, TOO_LONG = range(5)
 # most tracking steps a path may take in it
 WIDE_START = (4.0, 4.0, 500)
 WIDE_POSE = (4.0, math.inf, 100)
+# Per pose (wide_end infinite) the C tracker ends a path found going to infinity once it is beyond
+# this |Im θ| (ENDGAME_FAR of apair_ik_track.c: an endgame in log(1 − τ)); it may instead be going
+# to a finite point farther out, which double precision cannot tell apart, so the endpoints of a
+# pose beyond it are all taken as "far" (apair.ik.homotopy.endpoints), none of them real.
+ENDGAME_FAR = 8.0
 
 
 def unit_gamma(rng: np.random.Generator) -> complex:
@@ -34,13 +39,14 @@ def track(problem: Problem, p0, p1, gamma, start: np.ndarray, engine: str | None
     """Every row of start (k, n) from p0 to p1: (end, status, steps, cond). engine: "c" (the
     generated tracker apair_ik_track), "numpy" (track_numpy), or None: C where it is installed.
     wide: (track, end, steps), the |Im θ| beyond which the C tracker's Newton steps that stall take
-    the residual in extended precision, and the most tracking steps of a path in it."""
+    the residual in extended precision, and the most tracking steps of a path in it; with `end`
+    infinite (a pose's paths, WIDE_POSE) a path found going to infinity ends early (ENDGAME_FAR)."""
     start = np.ascontiguousarray(start, complex).reshape(-1, problem.n)
     native = native_in_use() if engine in (None, "c") else None
     if native is None:
         if engine == "c":
             raise RuntimeError("engine: the compiled C kernels are not installed")
-        return track_numpy(problem, p0, p1, gamma, start)
+        return track_numpy(problem, p0, p1, gamma, start, endgame=not wide[1] < math.inf)
     args = (
         problem.kind,
         problem.pair,
@@ -191,20 +197,70 @@ def solve_linear(A: np.ndarray, b: np.ndarray) -> np.ndarray:
         return out
 
 
-def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray):
+def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray, endgame: bool = False):
     """The tracker of apair_ik_track over NumPy, all paths at once (each with its own τ and step):
     the same predictor (RK4), corrector (Newton, at most `corrector_steps`, each step at most half
-    the one before), step control and endpoint test. The fallback without the C kernels, and an
-    independent check of the C tracker."""
+    the one before), step control, endgame (`endgame`: the paths of one pose) and endpoint test.
+    The fallback without the C kernels, and an independent check of the C tracker."""
     p0, dp = np.asarray(p0, complex), np.asarray(p1, complex) - np.asarray(p0, complex)
-    return track_system(lambda x, s: _batched(problem, x, s, p0, dp), gamma, start, problem.n)
+    return track_system(lambda x, s: _batched(problem, x, s, p0, dp), gamma, start, problem.n, endgame)
 
 
-def track_system(evaluate, gamma, start: np.ndarray, angles: int):
+# The endgame of apair_ik_track.c (to_infinity): from which τ it watches, how much a path to
+# infinity's slope in log(1 − τ) may shrink per sample, the least outward slope (and ENDGAME_FAR)
+ENDGAME = (0.5, 0.8, 0.1)
+
+
+class _Endgame:
+    """to_infinity of apair_ik_track.c for all paths at once: each path's last sample (L = log(1 −
+    τ), the angles) and the slope over the interval that ended there."""
+
+    def __init__(self, k: int, angles: int) -> None:
+        self.samples = np.zeros(k, int)
+        self.L = np.zeros(k)
+        self.v = np.zeros((k, angles), complex)
+        self.beta = np.zeros((k, angles), complex)
+
+    def diverged(self, rows: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """Which of the paths `rows`, just accepted at the angles v (r, angles) and τ (r,), go to
+        infinity (see to_infinity in apair_ik_track.c); their samples are taken where due."""
+        start, ratio, slope = ENDGAME
+        with np.errstate(divide="ignore"):
+            L = np.log1p(-tau)
+        take = (tau >= start) & (tau < 1) & ((self.samples[rows] == 0) | (self.L[rows] - L >= math.log(2)))
+        rows, v, L = rows[take], v[take], L[take]
+        out = np.zeros(len(take), bool)
+        had = self.samples[rows] > 0
+        beta = np.zeros_like(v)
+        beta[had] = (v[had] - self.v[rows[had]]) / (L[had] - self.L[rows[had]])[:, None]
+        j = np.argmax(np.abs(v.imag), axis=1)
+        at = np.arange(len(rows))
+        far = np.abs(v.imag)[at, j]
+        b, b0 = beta[at, j], self.beta[rows, j]
+        sign = np.where(v[at, j].imag > 0, -1.0, 1.0)
+        size = np.abs(b)
+        verdict = (
+            (self.samples[rows] >= 2)
+            & (far > ENDGAME_FAR)
+            & (sign * b.imag >= slope)
+            & (sign * b.imag >= ratio * sign * b0.imag)
+            & (np.abs(b - b0) <= 0.5 * size)
+            & (size >= ratio * np.abs(b0))
+            & (far > size * math.log(2) * ratio / (1 - ratio))
+        )
+        self.beta[rows[had]] = beta[had]
+        self.L[rows], self.v[rows] = L, v
+        self.samples[rows] += 1
+        out[np.flatnonzero(take)] = verdict
+        return out
+
+
+def track_system(evaluate, gamma, start: np.ndarray, angles: int, endgame: bool = False):
     """track_numpy's tracker for any square system H(x; s) = 0 from s = 0 to 1 along the γ arc:
     evaluate(x (k, m), s (k,)) gives H (k, m), dH/dx (k, m, m) and ∂H/∂s (k, m); the first
     `angles` columns of x are complex joint angles (the divergence and far-out tests look at
-    them; apair.ik.homotopy.trace tracks an extra column that is not an angle). Returns (end, status, steps, cond)."""
+    them; apair.ik.homotopy.trace tracks an extra column that is not an angle). endgame: end the
+    paths found going to infinity (_Endgame). Returns (end, status, steps, cond)."""
     o = TRACK
     g = complex(gamma)
     k = len(start)
@@ -213,6 +269,7 @@ def track_system(evaluate, gamma, start: np.ndarray, angles: int):
     good, steps = np.zeros(k, int), np.zeros(k, int)
     status = np.full(k, -1)
     k1s, have = np.zeros_like(v), np.zeros(k, bool)  # dv/dτ at (v, τ), as the C tracker keeps it
+    watch = _Endgame(k, angles) if endgame else None
 
     def s_of(t):
         den = 1 + (g - 1) * t
@@ -281,6 +338,8 @@ def track_system(evaluate, gamma, start: np.ndarray, angles: int):
             h[acc[grow]] = np.minimum(2 * h[acc[grow]], o["max_step"])
             good[acc[grow]] = 0
             status[acc[np.abs(v[acc, :angles].imag).max(1) > o["divergence"]]] = DIVERGED
+            if watch is not None:
+                status[acc[watch.diverged(acc, v[acc, :angles], tau[acc])]] = DIVERGED
             h[rej] *= 0.5
             good[rej] = 0
             status[rej[h[rej] < o["min_step"]]] = FAILED
