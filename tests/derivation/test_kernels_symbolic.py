@@ -6,7 +6,7 @@ import zlib
 
 import numpy as np
 import pytest
-from conftest import evaluate_spec
+from apair_test_helpers import evaluate_spec
 
 from apair.kernels import call, manifest
 

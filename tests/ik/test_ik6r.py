@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import arm_toml
+from apair_test_helpers import arm_toml
 
 import apair
 from apair.ik import elimination6r as ik6r

@@ -10,7 +10,7 @@ import dataclasses
 import flint
 import numpy as np
 import pytest
-from conftest import arm_toml
+from apair_test_helpers import arm_toml
 
 import apair
 from apair.cli import main as cli

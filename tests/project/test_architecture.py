@@ -146,3 +146,15 @@ def test_every_subpackage_ships():
     src = root / "src" / "apair"
     found = {"apair." + ".".join(p.parent.relative_to(src).parts) for p in src.rglob("__init__.py")}
     assert sorted(found - {"apair."} - listed) == []
+
+
+def test_no_test_imports_from_a_conftest():
+    """Helpers shared between folders live in tests/apair_test_helpers.py: `from conftest import`
+    resolves to whichever folder's conftest pytest loaded first (tests/design has its own)."""
+    tests = Path(__file__).resolve().parents[1]
+    offenders = [
+        str(p.relative_to(tests))
+        for p in tests.rglob("*.py")
+        if any(line.startswith(("from conftest import", "import conftest")) for line in p.read_text().splitlines())
+    ]
+    assert offenders == []
