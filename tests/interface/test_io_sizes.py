@@ -45,7 +45,7 @@ def test_thousands_of_joints_are_refused_before_any_work(tmp_path, key, no_colli
     1-to-6-joints check refused them."""
     path = write(tmp_path, f"[[joint]]\n{JOINT}{key}\n" * 3000)
     start = time.perf_counter()
-    load_error(path, str(path), "[[joint]]", "1 to 6", "3000")
+    load_error(path, str(path), "[[joint]]", "1 to 7", "3000")
     assert time.perf_counter() - start < 2
     assert no_collision_work == []
 

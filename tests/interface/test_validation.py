@@ -128,9 +128,9 @@ def test_theta_inside_general_range(limited):
 
 
 # ---------------------------------------------------------------- AChain construction
-@pytest.mark.parametrize("n", [0, 7])
+@pytest.mark.parametrize("n", [0, 8])
 def test_chain_number_of_pairs(n):
-    with pytest.raises(ValueError, match=r"^pairs: a chain has 1 to 6"):
+    with pytest.raises(ValueError, match=r"^pairs: a chain has 1 to 7"):
         AChain(sin_pairs(n), [0.1] * n, [0.0] * n)
 
 
@@ -370,7 +370,7 @@ GOOD = joints(SIN + "a = 0.3\nalpha_deg = 90\noffset = 0.1\n", GEN + "a = 0.25\n
         (joints(SIN + "a = 0.1\nalpha = inf\n"), r"joint 1\.alpha: expected a finite number, got inf"),
         ('name = "empty"\n', r"needs at least one \[\[joint\]\]"),
         ("joint = []\n", r"needs at least one \[\[joint\]\]"),
-        (joints(*[SIN + "a = 0.1\nalpha = 0\n"] * 7), r"pairs: a chain has 1 to 6 pairs, got 7"),
+        (joints(*[SIN + "a = 0.1\nalpha = 0\n"] * 8), r"pairs: a chain has 1 to 7 pairs, got 8"),
     ],
 )
 def test_load_rejects(tmp_path, text, match):
