@@ -228,17 +228,50 @@ def derive():
     return [gdp, motion], specs, facts
 
 
-# d(θ) of each kind and the law kernel's inputs: the forms derive() proves from the pair's quadric.
+# d(θ) of each kind and the law kernel's inputs: the forms derive() proves from the pair's quadric,
+# and the helical pair, of which the A-pair is the generalisation: d = pitch·θ (c_i, the joint's
+# constant offset, is in the chain's DH row).
+pitch = sp.Symbol("pitch", real=True)
 LAWS = {
     "revolute": (sp.S(0), (theta,)),
     "sinusoidal": (SINUSOIDAL_LAW, (theta, h)),
     "general": (sp.sqrt(a + b * sp.cos(theta)), (theta, a, b)),
+    "helical": (pitch * theta, (theta, pitch)),
 }
+# The prismatic pair, the helical pair's limit of infinite pitch: its joint variable is the slide
+# d itself, its angle the constant φ_i of the DH row; as a law of its variable q = d, the angle
+# is 0 (cos, sin of 0/2 = 1, 0) and d(q) = q.
+PRISMATIC_LAW = d
 
 
 def law_specs() -> list[KernelSpec]:
-    """The law kernels of the three kinds (derive() checks LAWS against the derivation)."""
-    return [law_spec(kind, expr, args) for kind, (expr, args) in LAWS.items()]
+    """The law kernels of every kind (derive() checks the A-pairs' LAWS against the derivation)."""
+    return [law_spec(kind, expr, args) for kind, (expr, args) in LAWS.items()] + [prismatic_law_spec()]
+
+
+def prismatic_law_spec() -> KernelSpec:
+    """Kernel: the slide q -> (cos(0/2), sin(0/2), d, d', d'') = (1, 0, q, 1, 0) of a prismatic pair,
+    the law values in its own variable q = d (the chain kernels take the derivatives in each
+    joint's variable and, for a prismatic joint, no turning: see derivations/chain_kinematics.py)."""
+    derivs = [sp.diff(PRISMATIC_LAW, d, k) for k in range(3)]
+    return KernelSpec(
+        name="law_prismatic",
+        doc=(
+            "The prismatic pair's law values at the slide d: cos(0/2), sin(0/2) (its angle is the "
+            "constant phi of its DH row), d and its first two derivatives in d, as the chain kernels take them."
+        ),
+        source=SOURCE,
+        inputs=[Arg("d", (1,), "joint slide [m]", (d,))],
+        outputs=[
+            Arg(
+                "law",
+                (5,),
+                "(cos(0/2), sin(0/2), d [m], dd/dd = 1, 0)",
+                exprs=(sp.cos(sp.S(0)), sp.sin(sp.S(0))) + tuple(derivs),
+            )
+        ],
+        steps=[],
+    )
 
 
 def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
@@ -250,13 +283,14 @@ def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
     formed in that order, which `APair.theta_limit` repeats in Python to find the last double of
     the range.
     """
-    names = {theta: "theta", h: "h", a: "a", b: "b"}
+    names = {theta: "theta", h: "h", a: "a", b: "b", pitch: "pitch"}
     inputs = [
         Arg(names[s], (1,), doc, (s,))
         for s, doc in zip(
             args,
             {
                 "revolute": ["joint angle [rad]"],
+                "helical": ["joint angle [rad]", "pitch [m/rad]: d = pitch theta"],
                 "sinusoidal": ["joint angle [rad]", "amplitude h = sqrt(2 r_b r_p) [m]"],
                 "general": [
                     "joint angle [rad], a + b cos(theta) >= 0",
@@ -290,6 +324,9 @@ def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
             assert abs(sp.N(e.subs(env).subs(vals) - ref.subs(vals), 30)) < 1e-25
     elif kind == "revolute":
         outs = [sp.S(0), sp.S(0), sp.S(0)]
+    elif kind == "helical":  # d = pitch·θ is linear in θ itself, not a function of its half angles
+        outs = derivs
+        assert outs == [pitch * theta, pitch, sp.S(0)], outs
     else:
         outs = [in_half(e) for e in derivs]
     return KernelSpec(

@@ -1,11 +1,13 @@
 """Equations of motion of nA-chains with leg inertia, n = 1..7 (docs/conventions.md §3-§4).
 
-Generalised coordinates: the angles θ, entering through each joint's law values (cos(θ/2),
-sin(θ/2), d, d', d''). Body j (j ≥ 1) is link j: it carries pair j's platform and frame j.
+Generalised coordinates: the joint variables q, entering through each joint's law values (cos(θ/2),
+sin(θ/2), d, d', d'', derivatives in q) and its turning factor w = dθ/dq: q is the angle θ of an
+R-, A- or H-pair (w = 1) and the slide d of a P-pair (w = 0, θ constant). Body j (j ≥ 1) is link j:
+it carries pair j's platform and frame j.
 
 Everything is computed in local link frames (Featherstone's formulation). Body i's coordinates are
 Q_i = frame_{i-1} · Rz(θ_i + φ_i) · Tz(c_i + d_i): its origin lies on joint i's axis, so the joint
-is a screw along z with the angle-dependent pitch d'_i, S_i = (e_z, d'_i e_z), and frame i is the
+is a screw along z with the variable pitch d'_i, S_i = (w_i e_z, d'_i e_z), and frame i is the
 constant Q_i · Tx(a_i) Rx(α_i). Parent to child is then four elementary motions (derivations/
 spatial.py). The legs of pair i are uniform slender rods from base points a (on body i−1, in pair
 i's base frame B_i = frame i−1, Σa = 0) to platform points b (on body i, b = Rz(θ_i) p + d_i e_z,
@@ -32,7 +34,7 @@ import sympy as sp
 
 from . import apair_pair
 from .autodiff import directional, gradient
-from .chain_kinematics import MAX_N, _Recorder, chain_inputs, joint_trig
+from .chain_kinematics import MAX_N, _Recorder, chain_inputs, joint_trig, turning_arg
 from .spatial import (
     Namer,
     add_inertia,
@@ -88,9 +90,10 @@ def dynamics_inputs(n: int):
     gvec = sp.symbols("g_x g_y g_z", real=True)
     args = {
         "law": law,
-        "qd": Arg("qd", (n,), "joint velocities theta'_i [rad/s]", tuple(j["qd"] for j in J)),
-        "qdd": Arg("qdd", (n,), "joint accelerations theta''_i [rad/s^2]", tuple(j["qdd"] for j in J)),
+        "qd": Arg("qd", (n,), "joint velocities q'_i [rad/s; m/s for a slide]", tuple(j["qd"] for j in J)),
+        "qdd": Arg("qdd", (n,), "joint accelerations q''_i [rad/s^2; m/s^2 for a slide]", tuple(j["qdd"] for j in J)),
         "dh": dh,
+        "turning": turning_arg(J),
         "links": Arg(
             "links",
             (n, 10),
@@ -163,13 +166,13 @@ class Assembly:
             _, ph, _ = inertia_to_parent([("tz", -j["c"])], (3 * j["ml"], ZERO3, None), nm, "Wp")
             self.weights.append((rec.name(f"Wm{i}", wm + 3 * j["ml"]), nm.vec("W", wh + ph)))
         # joint screws and the leg terms of pair i ≥ 2 (on body i−1, in B_i)
-        self.S = [(EZ, j["dd"] * EZ) for j in J]
+        self.S = [(j["w"] * EZ, j["dd"] * EZ) for j in J]
         self.coupling, self.cross = {}, {}
         for i in range(2, n + 1):
             j, K = J[i - 1], self.K[i]
             ml, trK = j["ml"], K.trace()
             self.coupling[i] = (2 * ml, ml * j["d"] * EZ, nm.sym3("Xs", ml / 3 * (trK * sp.eye(3) - (K + K.T) / 2)))
-            self.cross[i] = (ml / 6 * (trK * sp.eye(3) - K.T) * EZ, ml * j["dd"] * EZ)
+            self.cross[i] = (j["w"] * ml / 6 * (trK * sp.eye(3) - K.T) * EZ, ml * j["dd"] * EZ)
 
         # composite-rigid-body algorithm
         Ic = {n: self.bodies[n - 1]}
@@ -215,8 +218,9 @@ class Assembly:
         return self.rec.name(f"{tag}{nm.count + 1}m", sp.expand(m)), nm.vec(tag + "h", h), nm.sym3(tag, Ib)
 
     def _project(self, k, F):
-        """S_kᵀ F for a force F = (n, f) in Q_k: n_z + d'_k f_z."""
-        return F[0][2] + self.J[k - 1]["dd"] * F[1][2]
+        """S_kᵀ F for a force F = (n, f) in Q_k: w_k n_z + d'_k f_z."""
+        j = self.J[k - 1]
+        return j["w"] * F[0][2] + j["dd"] * F[1][2]
 
     def velocity_tangent(self) -> dict:
         """d/dt of the inputs along the motion: Σ_k θ'_k d/dθ_k."""
@@ -227,10 +231,11 @@ class Assembly:
         return tangent
 
     def seeds(self, k: int) -> dict:
-        """d/dθ_k of the inputs: cos(θ/2) → −sin(θ/2)/2, sin(θ/2) → cos(θ/2)/2 and, through the
-        law, d → d', d' → d''."""
+        """d/dq_k of the inputs: cos(θ/2) → −w sin(θ/2)/2, sin(θ/2) → w cos(θ/2)/2 (θ turns by
+        w_k q_k) and, through the law, d → d', d' → d''."""
         j = self.J[k - 1]
-        return {j["ch"]: -j["sh"] / 2, j["sh"]: j["ch"] / 2, j["d"]: j["dd"], j["dd"]: j["ddd"]}
+        w = j["w"]
+        return {j["ch"]: -w * j["sh"] / 2, j["sh"]: w * j["ch"] / 2, j["d"]: j["dd"], j["dd"]: j["ddd"]}
 
     def inputs(self, *names):
         return [self.args[nm] for nm in names]
@@ -433,7 +438,7 @@ def specs_for(n: int) -> list[KernelSpec]:
     g_steps, g = rnea(asm, [0] * n, [0] * n, gravity=True, prefix="g_")
     i_steps, tau = rnea(asm, qd, qdd, gravity=True, prefix="id_")
     c_steps, C = christoffel(asm)
-    kin = ("law", "dh")
+    kin = ("law", "dh", "turning")
     body = ("links", "legs")
     mass = KernelSpec(
         f"mass_matrix{n}",
@@ -447,14 +452,14 @@ def specs_for(n: int) -> list[KernelSpec]:
         f"inverse_dynamics{n}",
         f"Joint torques tau = M theta'' + C theta' + g ({n}) of a {n}-joint chain.",
         SOURCE,
-        asm.inputs("law", "qd", "qdd", "dh", *body, "gravity"),
+        asm.inputs("law", "qd", "qdd", "dh", "turning", *body, "gravity"),
         [Arg("tau", (n,), "joint torques [N m]", exprs=tuple(tau))],
         base + i_steps,
     )
     M_r = sp.Matrix(n, n, [sp.Symbol(f"rM{k}", real=True) for k in range(n * n)])
     b_r = [sp.Symbol(f"rb{k}", real=True) for k in range(n)]
     call_M = lambda *names: Call(mass, names, tuple(M_r))
-    call_bias = Call(inverse, ("law", "qd", None, "dh", "links", "legs", "gravity"), tuple(b_r))
+    call_bias = Call(inverse, ("law", "qd", None, "dh", "turning", "links", "legs", "gravity"), tuple(b_r))
     taus = [sp.Symbol(f"tau_{k}", real=True) for k in range(1, n + 1)]
     f_steps, qdd_fd = cholesky_solve(M_r, [t - b for t, b in zip(taus, b_r)], "fd_")
     tau_arg = Arg("tau", (n,), "joint torques tau_i [N m]", tuple(taus))
@@ -474,7 +479,7 @@ def specs_for(n: int) -> list[KernelSpec]:
             f"coriolis{n}",
             f"Coriolis matrix C(theta, theta') ({n} x {n}, Christoffel form) of a {n}-joint chain.",
             SOURCE,
-            asm.inputs("law", "qd", "dh", *body),
+            asm.inputs("law", "qd", "dh", "turning", *body),
             [Arg("C", (n, n), "C such that dM/dt - 2C is skew-symmetric, row-major", exprs=tuple(C))],
             base + c_steps,
         ),
@@ -482,9 +487,9 @@ def specs_for(n: int) -> list[KernelSpec]:
             f"bias{n}",
             f"Bias C(theta, theta') theta' + g(theta) ({n}) of a {n}-joint chain.",
             SOURCE,
-            asm.inputs("law", "qd", "dh", *body, "gravity"),
+            asm.inputs("law", "qd", "dh", "turning", *body, "gravity"),
             [Arg("bias", (n,), "bias torques [N m]", exprs=tuple(b_r))],
-            calls=[Call(inverse, ("law", "qd", None, "dh", "links", "legs", "gravity"), tuple(b_r))],
+            calls=[Call(inverse, ("law", "qd", None, "dh", "turning", "links", "legs", "gravity"), tuple(b_r))],
         ),
         inverse,
         KernelSpec(
@@ -492,19 +497,19 @@ def specs_for(n: int) -> list[KernelSpec]:
             f"Joint accelerations theta'' = M^-1 (tau - C theta' - g) ({n}) of a "
             f"{n}-joint chain, by Cholesky (NaN where M is not positive definite).",
             SOURCE,
-            asm.inputs("law", "qd") + [tau_arg] + asm.inputs("dh", *body, "gravity"),
+            asm.inputs("law", "qd") + [tau_arg] + asm.inputs("dh", "turning", *body, "gravity"),
             [Arg("qdd", (n,), "joint accelerations [rad/s^2]", exprs=tuple(qdd_fd))],
             f_steps,
-            calls=[call_M("law", "dh", "links", "legs"), call_bias],
+            calls=[call_M("law", "dh", "turning", "links", "legs"), call_bias],
         ),
         KernelSpec(
             f"energy{n}",
             f"Kinetic and potential energy (T, V) of a {n}-joint chain.",
             SOURCE,
-            asm.inputs("law", "qd", "dh", *body, "gravity"),
+            asm.inputs("law", "qd", "dh", "turning", *body, "gravity"),
             [Arg("energy", (2,), "(T, V) [J]", exprs=(T, asm.V))],
             base + asm.vrec.steps,
-            calls=[call_M("law", "dh", "links", "legs")],
+            calls=[call_M("law", "dh", "turning", "links", "legs")],
         ),
     ]
 

@@ -239,7 +239,7 @@ def system_spec(n: int) -> KernelSpec:
     )
     rec = _Recorder()
     F = frames(n, J, rec)
-    Jm = screw_jacobian(F, J)
+    Jm = screw_jacobian(F, J, turning=False)
     T = F[n]
     x = _rotation(J, rec)
     q, dq = tsyms[3:], dsyms[3:]

@@ -36,8 +36,20 @@ LAW_DOC = (
 def joint_symbols(i: int) -> dict[str, sp.Symbol]:
     """Symbols of joint i (1-based): the angle (for reference derivations), the law values
     ch, sh = cos, sin(θ/2) and d, d', d'', and the DH constants."""
-    names = ("theta",) + LAW_FIELDS + ("a", "alpha", "c", "phi")
+    names = ("theta",) + LAW_FIELDS + ("a", "alpha", "c", "phi", "w")
     return {k: sp.Symbol(f"{k}_{i}", real=True) for k in names}
+
+
+TURNING_DOC = (
+    "per joint w_i = d(theta_i)/dq_i: 1 where the joint variable q_i is the angle (R-, A- and H-pairs), "
+    "0 where it is the slide d_i (P-pairs)"
+)
+
+
+def turning_arg(J: list[dict]) -> Arg:
+    """The (n,) design input w of the kernels that differentiate in the joint variables (the
+    Jacobian, the dynamics): joint i turns by w_i q'_i and slides by d'_i q'_i."""
+    return Arg("turning", (len(J),), TURNING_DOC, tuple(j["w"] for j in J), design=True)
 
 
 def chain_inputs(n: int) -> tuple[list[Arg], list[dict]]:
@@ -196,16 +208,18 @@ def fk_study_spec(n: int) -> KernelSpec:
     )
 
 
-def screw_jacobian(F: list[sp.Matrix], J: list[dict]) -> sp.Matrix:
-    """Columns [z_{i-1} × (o_n − o_{i-1}) + d'_i z_{i-1}; z_{i-1}] from the frames."""
+def screw_jacobian(F: list[sp.Matrix], J: list[dict], turning: bool = True) -> sp.Matrix:
+    """Columns [w_i z_{i-1} × (o_n − o_{i-1}) + d'_i z_{i-1}; w_i z_{i-1}] from the frames, with
+    `turning` (else w_i = 1: every joint variable an angle)."""
     n = len(J)
     o_n = F[n][:3, 3]
     cols = []
     for i in range(1, n + 1):
         z = F[i - 1][:3, 2]
         o = F[i - 1][:3, 3]
-        v = z.cross(o_n - o) + J[i - 1]["dd"] * z
-        cols.append(v.col_join(z))
+        w = J[i - 1]["w"] if turning else 1
+        v = w * z.cross(o_n - o) + J[i - 1]["dd"] * z
+        cols.append(v.col_join(w * z))
     return sp.Matrix.hstack(*cols)
 
 
@@ -218,10 +232,11 @@ def jacobian_spec(n: int) -> KernelSpec:
         name=f"jacobian{n}",
         doc=(
             f"Geometric Jacobian (6 x {n}, base frame, rows [v; omega], v the velocity of the origin of "
-            f"frame {n}) of a {n}-joint chain; column i includes the pitch d'_i along z_(i-1)."
+            f"frame {n}) of a {n}-joint chain in the joint variables: column i turns by w_i and slides "
+            "by d'_i along z_(i-1)."
         ),
         source=SOURCE,
-        inputs=inputs,
+        inputs=inputs + [turning_arg(J)],
         steps=rec.steps,
         outputs=[Arg("J", (6, n), "Jacobian, row-major", exprs=tuple(Jm))],
     )
@@ -230,9 +245,10 @@ def jacobian_spec(n: int) -> KernelSpec:
 def check_jacobian(n: int, samples: int = 3, digits: int = 50) -> float:
     """Max |screw Jacobian − derivative of FK| over random points, in `digits`-digit arithmetic.
 
-    The derivative is taken on the fully expanded FK in the angles θ_i, with
-    d/dθ_i = ∂/∂θ_i + d'_i ∂/∂d_i, and the angular part from the skew matrix (∂R/∂θ_i) Rᵀ: an
-    independent route to the same columns (which come from the half-angle law values).
+    The derivative is taken on the fully expanded FK in the angles θ_i and slides d_i, with
+    d/dq_i = w_i ∂/∂θ_i + d'_i ∂/∂d_i (θ_i = w_i q_i, d_i = d_i(q_i)), and the angular part from the
+    skew matrix (∂R/∂q_i) Rᵀ: an independent route to the same columns (which come from the
+    half-angle law values), for any turning factors w_i.
     """
     _, J = chain_inputs(n)
     T = sp.eye(4)
@@ -241,7 +257,7 @@ def check_jacobian(n: int, samples: int = 3, digits: int = 50) -> float:
     R = T[:3, :3]
     cols = []
     for j in J:
-        dT = T.diff(j["theta"]) + j["dd"] * T.diff(j["d"])
+        dT = j["w"] * T.diff(j["theta"]) + j["dd"] * T.diff(j["d"])
         W = dT[:3, :3] * R.T
         cols.append(dT[:3, 3].col_join(sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])))
     J_diff = sp.Matrix.hstack(*cols)

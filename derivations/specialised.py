@@ -42,14 +42,14 @@ KERNELS = {
     "energy": "energy",
 }
 KINEMATIC = ("fk", "fk_study", "jacobian")
-KINDS = ("revolute", "sinusoidal", "general")
-_LAW_ARITY = {"revolute": 0, "sinusoidal": 1, "general": 2}
+KINDS = ("revolute", "sinusoidal", "general", "helical", "prismatic")
+_LAW_ARITY = {"revolute": 0, "sinusoidal": 1, "general": 2, "helical": 1, "prismatic": 0}
 
 
 @dataclass(frozen=True)
 class Design:
     """A chain's constants as plain numbers (the runtime's AChain in this form): per joint the
-    pair kind and its law kernel's constants after θ (() | (h,) | (a, b)), the DH row
+    pair kind and its law kernel's constants after its variable (() | (h,) | (a, b) | (pitch,)), the DH row
     (a, α, c, φ), the link row (mass, com (3), Ixx, Iyy, Izz, Ixy, Ixz, Iyz) and the legs row
     (leg mass, r_b, r_p); and gravity in the base frame."""
 
@@ -120,8 +120,14 @@ def _trivial(e: sp.Expr) -> bool:
 
 
 def design_values(design: Design, inputs: list[Arg]) -> dict:
-    """The numbers of the generic spec's design inputs (dh, links, legs, gravity)."""
-    rows = {"dh": design.dh, "links": design.links, "legs": design.legs, "gravity": (design.gravity,)}
+    """The numbers of the generic spec's design inputs (dh, turning, links, legs, gravity)."""
+    rows = {
+        "dh": design.dh,
+        "turning": (tuple(0.0 if k == "prismatic" else 1.0 for k in design.kinds),),
+        "links": design.links,
+        "legs": design.legs,
+        "gravity": (design.gravity,),
+    }
     env = {}
     for a in inputs:
         if not a.design:
@@ -136,7 +142,7 @@ def design_values(design: Design, inputs: list[Arg]) -> dict:
 
 def joint_values(n: int) -> Arg:
     syms = tuple(sp.Symbol(f"q_{i}", real=True) for i in range(1, n + 1))
-    return Arg("q", (n,), "joint values theta_i [rad]", syms)
+    return Arg("q", (n,), "joint values q_i: angles theta_i [rad], slides d_i [m] of prismatic pairs", syms)
 
 
 def law_steps(design: Design, law_symbols, q: Arg) -> tuple[list, dict]:

@@ -72,3 +72,40 @@ def arm_toml(folder):
     )
     path.write_text(f'name = "arm"\n{joints}')
     return path
+
+
+def loop_rows(d):
+    """The equality rows of MuJoCo's constraint data d (the loops, and helical couplings)."""
+    import mujoco
+
+    return d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+
+
+def closed_loop_qacc(m, qpos, qvel, ctrl):
+    """The accelerations of MuJoCo's model with its loops held exactly: M, qfrc_bias, the actuator
+    forces and the equality rows' Jacobian J, with J̇q̇ by central differences; the redundant rows
+    (six legs give one relation each) are handled by the null space of J."""
+    import mujoco
+
+    d = mujoco.MjData(m)
+    d.qpos[:], d.qvel[:], d.ctrl[:] = qpos, qvel, ctrl
+    mujoco.mj_forward(m, d)
+    J = d.efc_J.reshape(d.nefc, m.nv)[loop_rows(d)].copy()
+    M = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, M)
+    f = d.qfrc_actuator + d.qfrc_passive - d.qfrc_bias
+    eps, Js = 1e-6, []
+    for sign in (1, -1):
+        e = mujoco.MjData(m)
+        qp = np.array(qpos, float)
+        mujoco.mj_integratePos(m, qp, qvel, sign * eps)
+        e.qpos[:], e.qvel[:] = qp, qvel
+        mujoco.mj_forward(m, e)
+        Js.append(e.efc_J.reshape(e.nefc, m.nv)[loop_rows(e)].copy())
+    Jdqd = (Js[0] - Js[1]) @ qvel / (2 * eps)
+    _, S, Vt = np.linalg.svd(J)
+    rank = int((S > 1e-9 * S[0]).sum())
+    N = Vt[rank:].T
+    particular = -np.linalg.pinv(J, rcond=1e-9) @ Jdqd
+    z = np.linalg.solve(N.T @ M @ N, N.T @ (f - M @ particular))
+    return particular + N @ z, rank

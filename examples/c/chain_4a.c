@@ -28,6 +28,8 @@ static const double links[N][10] = {
     {1.8, -0.15, 0.0, 0.0, 0.003, 0.016, 0.016, 0.0, 0.0, 0.0},
     {0.8, 0.0, 0.0, 0.03, 0.001, 0.001, 0.0015, 0.0, 0.0, 0.0}};
 static const double leg_mass[N] = {0.06, 0.06, 0.05, 0.04};
+/* per joint dtheta/dq: 1 where the joint variable is the angle (R-, A-, H-pairs), 0 for a slide (P-pair) */
+static const double turning[N] = {1.0, 1.0, 1.0, 1.0};
 static const double gravity[3] = {0.0, 0.0, -9.81};
 
 static void print(const char *name, const double *x, int size)
@@ -66,8 +68,8 @@ int main(int argc, char **argv)
         legs[i][2] = radii[i][1];
     }
     apair_fk4(&law[0][0], &dh[0][0], T);
-    apair_jacobian4(&law[0][0], &dh[0][0], J);
-    apair_inverse_dynamics4(&law[0][0], qd, qdd, &dh[0][0], &links[0][0], &legs[0][0], gravity, tau);
+    apair_jacobian4(&law[0][0], &dh[0][0], turning, J);
+    apair_inverse_dynamics4(&law[0][0], qd, qdd, &dh[0][0], turning, &links[0][0], &legs[0][0], gravity, tau);
     printf("apair %s (%s)\n", APAIR_VERSION, APAIR_CONTENT_HASH);
     print("T", T, 16);
     print("J", J, 6 * N);

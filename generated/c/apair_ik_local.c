@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_local.c (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_local.c. Content hash: cb1f7ea7bd95909f
+ * generated/c. Do not edit: edit src/csrc/apair_ik_local.c. Content hash: 43524451f4e1e41c
  */
 /*
  * A damped least-squares (Levenberg-Marquardt) local solver of inverse kinematics on fk<n> and
@@ -16,8 +16,11 @@
 #define LOCAL_INV_MAX 1024
 
 /* The kernels of the local solver, with the design's invariants of fk and jacobian computed once. */
+#define LOCAL_KINDS 5 /* revolute, sinusoidal, general, helical, prismatic */
+
 typedef struct {
-    const apair_kernel *fk, *jac, *laws[3];
+    const apair_kernel *fk, *jac, *laws[LOCAL_KINDS];
+    double turning[LOCAL_NMAX]; /* dtheta/dq per joint: 0 for a prismatic pair */
     double inv_fk[LOCAL_INV_MAX], inv_jac[LOCAL_INV_MAX];
 } local_kernels;
 
@@ -32,7 +35,7 @@ static int chain_eval(const local_kernels *lk, const apair_ik_chain *ch, const d
         for (int k = 0; k < 5; k++)
             if (!isfinite(law[5 * i + k])) return -1;
     }
-    const double *in[2] = {law, ch->dh};
+    const double *in[3] = {law, ch->dh, lk->turning};
     double *outT[1] = {T};
     if (lk->fk->n_invariants) lk->fk->core(lk->inv_fk, in, outT); else lk->fk->eval(in, outT);
     if (J) {
@@ -73,19 +76,20 @@ int apair_ik_local(const apair_ik_chain *ch, size_t count, const double *target,
     local_kernels lk;
     lk.fk = apair_find_kernel(fks[n - 1]);
     lk.jac = apair_find_kernel(jacs[n - 1]);
-    lk.laws[0] = apair_find_kernel("law_revolute");
-    lk.laws[1] = apair_find_kernel("law_sinusoidal");
-    lk.laws[2] = apair_find_kernel("law_general");
-    if (!lk.fk || !lk.jac || !lk.laws[0] || !lk.laws[1] || !lk.laws[2] || lk.fk->n_invariants > LOCAL_INV_MAX ||
-        lk.jac->n_invariants > LOCAL_INV_MAX)
-        return -1;
+    static const char *law_names[LOCAL_KINDS] = {"law_revolute", "law_sinusoidal", "law_general", "law_helical",
+                                                 "law_prismatic"};
+    for (int k = 0; k < LOCAL_KINDS; k++)
+        if (!(lk.laws[k] = apair_find_kernel(law_names[k]))) return -1;
+    if (!lk.fk || !lk.jac || lk.fk->n_invariants > LOCAL_INV_MAX || lk.jac->n_invariants > LOCAL_INV_MAX) return -1;
+    for (int i = 0; i < n; i++) {
+        if (ch->kind[i] < 0 || ch->kind[i] >= LOCAL_KINDS) return -1;
+        lk.turning[i] = ch->kind[i] == 4 ? 0.0 : 1.0;
+    }
     {
-        const double *in[2] = {NULL, ch->dh};
+        const double *in[3] = {NULL, ch->dh, lk.turning};
         if (lk.fk->n_invariants) lk.fk->invariants(in, lk.inv_fk);
         if (lk.jac->n_invariants) lk.jac->invariants(in, lk.inv_jac);
     }
-    for (int i = 0; i < n; i++)
-        if (ch->kind[i] < 0 || ch->kind[i] > 2) return -1;
     for (size_t j = 0; j < count; j++) {
         const double *Tt = target + (ptrdiff_t)j * target_stride;
         double *x = q + j * n;

@@ -227,7 +227,7 @@ static const ik_entry ik_entries[] = {
                    {"upper", F64, 1, {N}}, {"target", F64, 3, {ANY, 4, 4}}, {"seed", F64, 2, {ANY, N}}},
         .out = {{"q", F64, 2, {ROWS, N}}, {"residual", F64, 1, {ROWS}}, {"converged", I32, 1, {ROWS}}},
         .rows = 7, .nogil = 1, .prepare = prepare_local, .run = run_local,
-        .error = "ik_local: the chain is not valid (kinds 0, 1 or 2; 1 to 7 joints)",
+        .error = "ik_local: the chain is not valid (kinds 0 to 4; 1 to 7 joints)",
     },
     [IK4_PENCIL] = {
         .format = "OOOOOdid", /* C, Qf, af, Qg, ag, cond_max, deflate, deflate_tol */
@@ -473,8 +473,8 @@ static int local_init(LocalIKObject *self, PyObject *args, PyObject *kwds)
         return -1;
     }
     for (int i = 0; i < n; i++) {
-        if (self->kind[i] < 0 || self->kind[i] > 2 || !(self->lower[i] <= self->upper[i])) {
-            PyErr_Format(PyExc_ValueError, "LocalIK: joint %d has kind %d (0, 1 or 2) and range (%g, %g)", i + 1,
+        if (self->kind[i] < 0 || self->kind[i] > 4 || !(self->lower[i] <= self->upper[i])) {
+            PyErr_Format(PyExc_ValueError, "LocalIK: joint %d has kind %d (0 to 4) and range (%g, %g)", i + 1,
                          self->kind[i], self->lower[i], self->upper[i]);
             return -1;
         }
@@ -583,7 +583,7 @@ static PyObject *local_call(LocalIKObject *self, PyObject *const *args, Py_ssize
     *(npy_bool *)PyArray_DATA((PyArrayObject *)out[2]) = converged != 0;
     result = rc == 0 ? PyObject_Vectorcall(self->result, out, 3, NULL) : NULL;
     if (rc != 0) {
-        PyErr_SetString(PyExc_ValueError, "ik_local: the chain is not valid (kinds 0, 1 or 2; 1 to 7 joints)");
+        PyErr_SetString(PyExc_ValueError, "ik_local: the chain is not valid (kinds 0 to 4; 1 to 7 joints)");
     }
     Py_DECREF(out[0]);
     Py_DECREF(out[1]);

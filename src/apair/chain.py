@@ -128,6 +128,7 @@ class AChain:
         V.in_range("gravity", self.gravity, "m/s^2")
         self._links = np.ascontiguousarray(np.stack([link.as_row() for link in links]))
         self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pair_list])
+        self._turning = np.array([p.turning for p in pair_list])  # dθ/dq: 0 for a P-pair
         self._base_T, self._tool_T = check_frame("base", base), check_frame("tool", tool)
         self._framed = self._base_T is not None or self._tool_T is not None
         # the kernels' gravity is in the DH base frame (frame 0): Rbᵀ·g
@@ -223,8 +224,9 @@ class AChain:
         self._use(self._native_chain())
 
     def _check_limits(self, limits: Iterable[ArrayLike | None] | None) -> list[tuple[float, float] | None]:
+        slides = [i for i, p in enumerate(self.pairs) if p.kind == "prismatic"]
         if limits is None:
-            return [None] * self.n
+            limits = [None] * self.n
         try:
             entries = list(limits)
         except TypeError as exc:
@@ -233,6 +235,8 @@ class AChain:
             raise ValueError(f"limits: expected {self.n} entries (one per pair), got {len(entries)}")
         out: list[tuple[float, float] | None] = []
         for i, lim in enumerate(entries):
+            if lim is None and i in slides:
+                raise ValueError(f"limits[{i}]: joint {i + 1} is prismatic: give its range (lo, hi) in metres")
             if lim is None:
                 out.append(None)
                 continue
@@ -250,7 +254,7 @@ class AChain:
 
     @property
     def limits(self) -> NDArray[np.float64]:
-        """(n, 2): each joint's range [rad]: the explicit one if given, else the pair's collision
+        """(n, 2): each joint's range [rad; m for a P-pair]: the explicit one if given, else the pair's collision
         limits (`APair.collision_limits`), within its range of motion; a free joint gets one turn
         (−π, π)."""
         out = self.hard_limits()
@@ -303,7 +307,7 @@ class AChain:
             [(f"{family}{self.n}", strict) for family, strict in METHODS],
             [p.law_kernel for p in self.pairs],
             [p.theta_limit if p.theta_limit is not None else math.inf for p in self.pairs],
-            {"dh": self._dh, "links": self._links, "legs": self._legs, "gravity": self._gravity},
+            dict(zip(("dh", "turning", "links", "legs", "gravity"), self._body)),
         )
 
     def law(self, q: ArrayLike) -> NDArray[np.float64]:
@@ -387,18 +391,18 @@ class AChain:
         """(..., 6, n): geometric Jacobian in the world frame, rows [v; ω] (v of the tool's origin;
         without base and tool frames, of frame n's origin in frame 0)."""
         out = self._call(2, q)
-        return out if out is not None else self._evaluate(2, "jacobian", q, (self._dh,))
+        return out if out is not None else self._evaluate(2, "jacobian", q, self._body[:2])
 
     # ----------------------------------------------------------------------------- dynamics
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
         """(..., n, n): M(θ), legs included."""
         out = self._call(3, q)
-        return out if out is not None else self._evaluate(3, "mass_matrix", q, self._body[:3])
+        return out if out is not None else self._evaluate(3, "mass_matrix", q, self._body[:4])
 
     def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
         """(..., n, n): C(θ, θ') in Christoffel form (Ṁ − 2C is skew-symmetric)."""
         out = self._call(4, q, qd)
-        return out if out is not None else self._evaluate(4, "coriolis", q, self._body[:3], qd=qd)
+        return out if out is not None else self._evaluate(4, "coriolis", q, self._body[:4], qd=qd)
 
     def gravity_torques(self, q: ArrayLike) -> NDArray[np.float64]:
         """(..., n): g(θ) = ∂V/∂θ."""
@@ -435,7 +439,7 @@ class AChain:
 
     @property
     def _body(self) -> tuple[NDArray[np.float64], ...]:
-        return self._dh, self._links, self._legs, self._gravity
+        return self._dh, self._turning, self._links, self._legs, self._gravity
 
     def specialise(self, kernels: Iterable[str] | None = None) -> AChain:
         """This chain with its design built into its own kernels (`apair codegen`'s C, compiled

@@ -238,7 +238,7 @@ def check_design(pair: PairLike) -> None:
     collision limits do not exist or cannot be found: legs or plates that overlap at θ = 0 (the
     pair cannot move), or proportions (triangles too unequal, legs too long) that the touch
     tolerance cannot resolve. Cheap (no polynomials): chain files are checked with it on loading."""
-    if pair.kind == "revolute":
+    if pair.kind not in ("sinusoidal", "general"):  # a lower pair: no legs, no plates
         return
     _check_proportions(pair)
     pts = pair.leg_endpoints(0.0)
@@ -280,7 +280,7 @@ def _check_proportions(pair: PairLike) -> None:
 def limits(pair: PairLike) -> CollisionLimits:
     """The collision-free interval around θ = 0 (see the module docstring), computed on the pair
     in units of its size, so that the answer is the same at every scale."""
-    if pair.kind == "revolute":
+    if pair.kind not in ("sinusoidal", "general"):  # a lower pair: nothing to collide
         return CollisionLimits(-math.inf, math.inf, "none")
     check_design(pair)
     end = pair.theta_limit  # the range end of the pair itself (the unit pair's differs by rounding)

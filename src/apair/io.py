@@ -2,13 +2,16 @@
 
 name = "a 2A-chain"            # optional; description = "..." optional (may span lines)
 [[joint]]                      # one table per joint, base to tip
-pair = "sinusoidal"            # "sinusoidal" | "general" | "revolute"
+pair = "sinusoidal"            # "sinusoidal" | "general" | "revolute" | "helical" | "prismatic"
 base_radius = 0.05             # A-pairs: triangle circumradii [m]
 platform_radius = 0.05
 leg_length = 0.08              # "general" only: L1 [m]
 leg_mass = 0.0                 # optional [kg]; leg_radius = 0.0, thickness = 0.0 optional [m]
 limits = [-1.0, 1.0]           # optional joint range [rad] (or limits_deg); default: the
-                               # pair's collision limits (a full turn for an R-pair)
+                               # pair's collision limits (a full turn for an R-pair); a
+                               # "prismatic" pair's range [m], required (its joint variable is
+                               # the slide d; its angle is theta_offset)
+pitch = 0.002                  # "helical" only: d = pitch * theta [m/rad]
 a = 0.3                        # DH link length [m]
 alpha = 1.5707963267948966     # DH twist [rad], or alpha_deg = 90
 offset = 0.0                   # c_i [m] (optional)
@@ -50,6 +53,8 @@ _PAIR_KEYS = {
     "sinusoidal": {"base_radius", "platform_radius", "leg_mass", "leg_radius", "thickness"},
     "general": {"base_radius", "platform_radius", "leg_length", "leg_mass", "leg_radius", "thickness"},
     "revolute": set(),
+    "helical": {"pitch"},
+    "prismatic": set(),
 }
 _DH_KEYS = {"a", "alpha", "alpha_deg", "offset", "theta_offset", "theta_offset_deg", "limits", "limits_deg"}
 _LINK_KEYS = {"mass", "com", "inertia"}
@@ -172,10 +177,20 @@ def _angle(where: str, j: dict[str, Any], key: str, default: float | None = None
 
 
 def _limits(where: str, j: dict[str, Any], pair: APair) -> tuple[float, float] | None:
-    """A joint's explicit (lo, hi) in radians, or None; checked against the pair's collision-free
-    range here, so that the message uses the file's key and units."""
+    """A joint's explicit (lo, hi) in radians (metres for a P-pair), or None; checked against the
+    pair's collision-free range here, so that the message uses the file's key and units."""
     if "limits" in j and "limits_deg" in j:
         raise ValueError(f"{where}: give limits or limits_deg, not both")
+    if pair.kind == "prismatic":
+        if "limits_deg" in j:
+            raise ValueError(f"{where}.limits_deg: a prismatic joint's range is in metres: give limits")
+        if "limits" not in j:
+            raise ValueError(f"{where}: missing limits (a prismatic joint's range [lo, hi] in metres)")
+        lo, hi = _numbers(f"{where}.limits", j["limits"], [(2,)])
+        V.in_range(f"{where}.limits", np.array([lo, hi]), "m")
+        if not lo < hi:
+            raise ValueError(f"{where}.limits: expected lo < hi, got ({lo:g}, {hi:g}) m")
+        return lo, hi
     for key, unit, scale in (("limits", "rad", 1.0), ("limits_deg", "deg", math.pi / 180)):
         if key in j:
             lo, hi = values = _numbers(f"{where}.{key}", j[key], [(2,)])
@@ -224,6 +239,15 @@ def _pair(w: str, j: dict[str, Any], kind: str) -> APair:
     (legs or plates that overlap: `check_design`), named by the file's keys."""
     if kind == "revolute":
         return APair.revolute()
+    if kind == "prismatic":
+        return APair.prismatic()
+    if kind == "helical":
+        if "pitch" not in j:
+            raise ValueError(f"{w}: missing pitch (d = pitch * theta, m/rad)")
+        try:
+            return APair.helical(_number(f"{w}.pitch", j["pitch"]))
+        except ValueError as exc:
+            raise ValueError(f"{w}.{exc}") from None
     kw = {k: _number(f"{w}.{k}", j[k]) for k in _PAIR_KEYS[kind] if k in j}
     for req in ("base_radius", "platform_radius") + (("leg_length",) if kind == "general" else ()):
         if req not in kw:

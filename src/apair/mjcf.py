@@ -21,7 +21,10 @@ Body tree, in the frames of docs/conventions.md §3:
   world) is frame 0.
 - The world is apair's world (gravity as chain.gravity): frame 0 is placed at chain.base, so the
   first pair's base plate, legs, site and link body sit at the base's pose.
-- One motor per pair (`pair{i}_motor`) on the hinge: ctrl = τ_i, the torque about axis i.
+- A prismatic pair has only its slide `pair{i}_d` (range: its limits in metres), a helical pair its
+  hinge and its slide coupled by a joint equality `pair{i}_helix` (d = pitch·θ).
+- One motor per pair (`pair{i}_motor`) on the hinge (the slide of a P-pair): ctrl = τ_i, the torque
+  about axis i (the force along it).
 - Plates (triangles of the pair's radii) and legs are visible geoms that do not collide unless
   `collisions=True`.
 
@@ -126,8 +129,9 @@ def _check_within_limits(chain: ChainLike, q: NDArray[np.float64]) -> None:
     mechanism's legs or plates collide or an explicit limit stops it; a free joint takes any angle."""
     for i, (lo, hi) in enumerate(chain.hard_limits()):
         if not lo <= q[i] <= hi:
+            unit = "m" if chain.pairs[i].kind == "prismatic" else "rad"
             raise Refusal(
-                f"q: joint {i + 1} at {q[i]:.10g} rad is outside its limits ({lo:.10g}, {hi:.10g}) rad",
+                f"q: joint {i + 1} at {q[i]:.10g} {unit} is outside its limits ({lo:.10g}, {hi:.10g}) {unit}",
                 "outside_limits",
                 "to export it anyway",
             )
@@ -149,9 +153,13 @@ def state(
         raise ValueError(f"qd: expected {chain.n} joint rates, got shape {qd.shape}")
     qpos, qvel = [], []
     for i, pair in enumerate(chain.pairs):  # the document order: pair i's legs, then its hinge and slide
-        if pair.kind == "revolute":
-            qpos.append(q[i])
-            qvel.append(qd[i])
+        if not pair.is_apair:
+            if pair.kind == "helical":
+                qpos += [q[i], pair.pitch * q[i]]
+                qvel += [qd[i], pair.pitch * qd[i]]
+            else:
+                qpos.append(q[i])
+                qvel.append(qd[i])
             continue
         d, dd = pair.law(q[i])[:2]
         if not (d > FLAT * max(pair.base_radius, pair.platform_radius) and np.isfinite(dd)):
@@ -177,22 +185,25 @@ def state(
 
 
 def _mass_scale(chain: ChainLike) -> float:
-    masses = [lk.mass for lk in chain.links] + [p.leg_mass for p in chain.pairs if p.kind != "revolute"]
+    masses = [lk.mass for lk in chain.links] + [p.leg_mass for p in chain.pairs if p.is_apair]
     return max([m for m in masses if m > 0], default=1.0)
 
 
 def _size(chain: ChainLike, i: int) -> float:
     p = chain.pairs[i]
-    if p.kind != "revolute":
+    if p.is_apair:
         return max(p.base_radius, p.platform_radius)
     return max(0.02, 0.1 * max(np.abs(chain.a).max(), np.abs(chain.offset).max(), 0.1))
 
 
 def _hinge(chain: ChainLike, i: int, limits: bool) -> str:
-    """Pair i's hinge; with `limits`, its range is the joint's hard limits (repr digits: the same
-    floats), as stiff as the loops (a collision stops the real joint dead); none for a joint that
-    turns freely."""
-    head = f'<joint name="pair{i + 1}_theta" type="hinge" axis="0 0 1"'
+    """Pair i's hinge (a P-pair's slide); with `limits`, its range is the joint's hard limits (repr
+    digits: the same floats), as stiff as the loops (a collision stops the real joint dead); none
+    for a joint that turns freely."""
+    if chain.pairs[i].kind == "prismatic":
+        head = f'<joint name="pair{i + 1}_d" type="slide" axis="0 0 1"'
+    else:
+        head = f'<joint name="pair{i + 1}_theta" type="hinge" axis="0 0 1"'
     lo, hi = chain.hard_limits()[i]
     if not (limits and math.isfinite(lo) and math.isfinite(hi)):
         return head + "/>"
@@ -275,7 +286,7 @@ def to_mjcf(
             f'{indent}<site name="pair{n1}_base" pos="{_f(p_prev)}" quat="{_f(quat_prev)}" size="{_f(0.1 * size)}"/>'
         )
         h0 = 0.0
-        if pair.kind != "revolute":
+        if pair.is_apair:
             h0 = pair.translation(0.0)
             base, length, frames = _reference_legs(pair)
             # the base plate (in frame i−1) and the legs
@@ -310,7 +321,9 @@ def to_mjcf(
         out.append(f'{indent}<body name="link{n1}" pos="{_f(p_body)}" quat="{_f(quat_prev)}">')
         ind = indent + "  "
         out.append(ind + _hinge(chain, i, limits))
-        if pair.kind != "revolute":
+        if pair.kind == "helical":
+            out.append(f'{ind}<joint name="pair{n1}_d" type="slide" axis="0 0 1"/>')
+        if pair.is_apair:
             top = float(max(np.max(pair.translation(np.linspace(*pair.motion_range(), 721))), h0))
             out.append(
                 f'{ind}<joint name="pair{n1}_d" type="slide" axis="0 0 1" ref="{_f(h0)}" range="0 {_f(2 * top)}"/>'
@@ -319,7 +332,7 @@ def to_mjcf(
         link = chain.links[i]
         inertial(ind, link.mass, p_off + R_off @ link.com, R_off, link.inertia)
         out.append(f'{ind}<site name="pair{n1}_platform" size="{_f(0.1 * size)}"/>')
-        if pair.kind != "revolute":
+        if pair.is_apair:
             plate(ind, f"pair{n1}_platform_plate", pair.platform_radius, np.pi / 3, 0.0, pair.thickness or None)
         # the link's drawn body: platform origin → along z by c_i → frame i
         knee = np.array([0, 0, chain.offset[i]])
@@ -339,8 +352,14 @@ def to_mjcf(
     eq, motors = [], []
     for i, pair in enumerate(chain.pairs):
         n1 = i + 1
-        motors.append(f'    <motor name="pair{n1}_motor" joint="pair{n1}_theta" gear="1"/>')
-        if pair.kind == "revolute":
+        driven = "d" if pair.kind == "prismatic" else "theta"
+        motors.append(f'    <motor name="pair{n1}_motor" joint="pair{n1}_{driven}" gear="1"/>')
+        if pair.kind == "helical":
+            eq.append(
+                f'    <joint name="pair{n1}_helix" joint1="pair{n1}_d" joint2="pair{n1}_theta" '
+                f'polycoef="0 {_f(pair.pitch)} 0 0 0"/>'
+            )
+        if not pair.is_apair:
             continue
         for k, L in enumerate(_reference_legs(pair)[1]):
             eq.append(
@@ -379,9 +398,10 @@ def joint_order(chain: ChainLike) -> list[str]:
     names = []
     for i, pair in enumerate(chain.pairs):
         n1 = i + 1
-        if pair.kind != "revolute":
+        if pair.is_apair:
             names += [f"pair{n1}_leg{k}_ball" for k in range(1, 7)]
-        names.append(f"pair{n1}_theta")
+        if pair.kind != "prismatic":
+            names.append(f"pair{n1}_theta")
         if pair.kind != "revolute":
             names.append(f"pair{n1}_d")
     return names

@@ -22,7 +22,8 @@ if TYPE_CHECKING:
     from .collisions import CollisionLimits
     from .link import Link
 
-KINDS = ("sinusoidal", "general", "revolute")
+KINDS = ("sinusoidal", "general", "revolute", "helical", "prismatic")
+A_KINDS = ("sinusoidal", "general")  # the A-pairs: a Griffis-Duffy platform with legs
 _SINUSOIDAL_RTOL = 1e-12  # |a - b| <= this * b: the leg length is the sinusoidal one
 
 
@@ -55,6 +56,9 @@ class APair:
 
     leg_mass and leg_radius describe the legs (uniform rods; used by dynamics and collisions), and
     thickness the plates (slabs about the planes of the leg end points; used by collisions).
+    `APair.revolute()`, `APair.helical(pitch)` and `APair.prismatic()` are the lower pairs a chain
+    may mix with A-pairs (no legs): the joint variable is the angle θ of an R-, A- or H-pair, the
+    slide d [m] of a P-pair (whose angle is the joint's constant theta_offset).
     """
 
     def __init__(
@@ -97,19 +101,54 @@ class APair:
     @classmethod
     def revolute(cls) -> APair:
         """An R-pair: no translation (d ≡ 0) and no legs."""
+        return cls._lower("revolute")
+
+    @classmethod
+    def helical(cls, pitch: ArrayLike) -> APair:
+        """An H-pair: d = pitch·θ [m], pitch in m/rad (the lead per turn is 2π·pitch); no legs."""
+        p = V.scalar("pitch", pitch)
+        V.in_range("pitch", p, "m/rad")
+        self = cls._lower("helical")
+        self.pitch = p
+        return self
+
+    @classmethod
+    def prismatic(cls) -> APair:
+        """A P-pair: the joint variable is the slide d [m] along the axis, the angle is constant
+        (the joint's theta_offset); no legs. Its chain needs its range (limits, in metres)."""
+        return cls._lower("prismatic")
+
+    @classmethod
+    def _lower(cls, kind: str) -> APair:
         self = cls.__new__(cls)
-        self.kind = "revolute"
+        self.kind = kind
         self.base_radius = self.platform_radius = 0.0
         self.leg_mass = self.leg_radius = self.thickness = 0.0
         self._limits = None
         self._L = None
         self.a = self.b = 0.0
-        self._h = 0.0
+        self._h = 0.0 if kind == "revolute" else None
         return self
+
+    pitch = 0.0  # m/rad: a helical pair's (d = pitch·θ)
+
+    @property
+    def is_apair(self) -> bool:
+        """Whether this is an A-pair (sinusoidal or general, with legs), not a lower pair."""
+        return self.kind in A_KINDS
+
+    @property
+    def turning(self) -> float:
+        """dθ/dq: 1 where the joint variable q is the angle, 0 for a P-pair (q is the slide)."""
+        return 0.0 if self.kind == "prismatic" else 1.0
 
     def __repr__(self) -> str:
         if self.kind == "revolute":
             return "APair.revolute()"
+        if self.kind == "prismatic":
+            return "APair.prismatic()"
+        if self.kind == "helical":
+            return f"APair.helical({self.pitch!r})"
         extra = "" if self.kind == "sinusoidal" else f", leg_length={cast(tuple[float, float], self._L)[0]!r}"
         for key in ("leg_mass", "leg_radius", "thickness"):  # every parameter off its default
             if getattr(self, key) != 0.0:
@@ -118,7 +157,10 @@ class APair:
 
     @property
     def amplitude(self) -> float:
-        """The platform's rise d(0) − min d over the motion: h = √(2 r_b r_p) for a sinusoidal pair."""
+        """The platform's rise d(0) − min d over the motion: h = √(2 r_b r_p) for a sinusoidal pair,
+        0 for an R-pair; a P- or H-pair's d is unbounded (ValueError)."""
+        if self.kind in ("helical", "prismatic"):
+            raise ValueError(f"amplitude: a {self.kind} pair's translation is unbounded")
         if self._h is not None:
             return self._h
         return math.sqrt(self.a + self.b) - math.sqrt(max(self.a - self.b, 0.0))
@@ -192,8 +234,10 @@ class APair:
     def law_kernel(self) -> tuple[str, tuple[float, ...]]:
         """The generated kernel of this pair's law values (cos(θ/2), sin(θ/2), d, d', d'') and
         its parameters after θ."""
-        if self.kind == "revolute":
-            return "law_revolute", ()
+        if self.kind in ("revolute", "prismatic"):
+            return f"law_{self.kind}", ()
+        if self.kind == "helical":
+            return "law_helical", (self.pitch,)
         if self.kind == "sinusoidal":
             return "law_sinusoidal", (cast(float, self._h),)
         return "law_general", (self.a, self.b)
@@ -225,6 +269,8 @@ class APair:
         the legs are this pair's. See `apair show apair_dynamics` for the closed forms."""
         from .link import Link
 
+        if self.kind == "prismatic":
+            raise ValueError("dynamics: a prismatic pair does not turn; use a one-joint AChain for its dynamics")
         if platform is None:
             platform = Link(0.0)
         if not isinstance(platform, Link):
@@ -251,7 +297,7 @@ class APair:
     def leg_endpoints(self, theta: ArrayLike) -> NDArray[np.float64]:
         """(..., 6, 2, 3): [base point, platform point] of each leg in the pair's base frame."""
         th = self._theta(theta)
-        if self.kind == "revolute":
+        if not self.is_apair:
             return np.zeros(th.shape + (0, 2, 3))
         d = self._law(th)[..., 2]
         return call("pair_legs", th[..., None], d[..., None], [self.base_radius, self.platform_radius])[0]

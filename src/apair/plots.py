@@ -40,7 +40,7 @@ def segments(chain: AChain, q: ArrayLike) -> list[Segment]:
     for i, (pair, th) in enumerate(zip(chain.pairs, q)):
         phi = chain.theta_offset[i]
         F = T[:3, :3] @ np.array([[math.cos(phi), -math.sin(phi), 0], [math.sin(phi), math.cos(phi), 0], [0, 0, 1]])
-        if pair.kind != "revolute":
+        if pair.is_apair:
             legs = pair.leg_endpoints(th) @ F.T + T[:3, 3]
             out += [(leg[0], leg[1], "leg") for leg in legs]
             for tri in (legs[:3, 0], legs[3:, 1]):  # base vertices, platform vertices
@@ -68,7 +68,7 @@ def _draw(ax: Axes3D, chain: AChain, q: ArrayLike, extent: float, segs: Sequence
 
     points_per_m = 72 * 0.8 * ax.figure.get_figwidth() / (2 * extent)  # the axes span about 2·extent
     segs = segments(chain, q) if segs is None else segs
-    legs = [p.leg_radius for p in chain.pairs if p.kind != "revolute" for _ in range(6)]
+    legs = [p.leg_radius for p in chain.pairs if p.is_apair for _ in range(6)]
     k = 0
     for a, b, kind in segs:
         if kind == "link":
@@ -115,8 +115,8 @@ def pair_animation(pair: APair, path: str | os.PathLike[str], frames: int = 48, 
     from matplotlib.animation import FuncAnimation, PillowWriter
 
     p = target(path, overwrite, suffix=".gif")
-    if pair.kind == "revolute":
-        raise ValueError("pair: an R-pair has no legs to animate")
+    if not pair.is_apair:
+        raise ValueError(f"pair: a {pair.kind} pair has no legs to animate")
     lim = pair.collision_limits()
     lo = lim.theta_min if math.isfinite(lim.theta_min) else -math.pi
     hi = lim.theta_max if math.isfinite(lim.theta_max) else math.pi

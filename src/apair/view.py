@@ -69,8 +69,9 @@ def chain_data(chain: ChainLike, workspace: int = 0, seed: int = 0) -> dict[str,
     for i, p in enumerate(chain.pairs):
         kernel, params = p.law_kernel
         lo, hi = lim[i]
-        period = 2 * np.pi if p.kind == "revolute" else 4 * np.pi
-        lo, hi = (max(lo, -period / 2), min(hi, period / 2))
+        if p.kind in ("revolute", "sinusoidal", "general"):  # one period of the pose (a slide's range as it is)
+            period = 2 * np.pi if p.kind == "revolute" else 4 * np.pi
+            lo, hi = (max(lo, -period / 2), min(hi, period / 2))
         j: dict[str, Any] = {
             "kind": p.kind,
             "law": kernel,
@@ -79,7 +80,7 @@ def chain_data(chain: ChainLike, workspace: int = 0, seed: int = 0) -> dict[str,
             "lower": float(lo),
             "upper": float(hi),
         }
-        if p.kind != "revolute":
+        if p.is_apair:
             j["radii"] = [float(p.base_radius), float(p.platform_radius)]
             j["leg_radius"] = float(p.leg_radius)
             j["clearance"] = _clearance_table(p, lo, hi)

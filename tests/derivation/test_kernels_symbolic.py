@@ -113,12 +113,13 @@ def test_batched_broadcasts_shared_inputs(backend):
     links = np.tile([1.0, 0.1, 0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0], (3, 1))
     legs, g = np.zeros((3, 3)), np.array([0.0, 0.0, -9.81])
     law[..., :2] = np.stack([np.cos(law[..., 0]), np.sin(law[..., 0])], axis=-1)
-    shared = call("forward_dynamics3", law, *chain_args, dh, links, legs, g)[0]
+    turning = np.ones(3)
+    shared = call("forward_dynamics3", law, *chain_args, dh, turning, links, legs, g)[0]
     repeated = call(
         "forward_dynamics3",
         law,
         *chain_args,
-        *(np.broadcast_to(x, (11,) + x.shape).copy() for x in (dh, links, legs, g)),
+        *(np.broadcast_to(x, (11,) + x.shape).copy() for x in (dh, turning, links, legs, g)),
     )[0]
     np.testing.assert_array_equal(shared, repeated)
 
@@ -129,7 +130,8 @@ def test_non_contiguous_inputs(backend):
     big = rng.uniform(-3, 3, (20, 3, 10))
     law = big[:, :, ::2]  # a strided view, (20, 3, 5)
     dh = np.asfortranarray(rng.uniform(-1, 1, (3, 4)))
-    got = call("jacobian3", law, dh)[0]
-    want = call("jacobian3", np.ascontiguousarray(law), np.ascontiguousarray(dh))[0]
+    turning = np.array([1.0, 9.0, 0.0, 9.0, 1.0])[::2]  # strided too: a slide in the middle
+    got = call("jacobian3", law, dh, turning)[0]
+    want = call("jacobian3", np.ascontiguousarray(law), np.ascontiguousarray(dh), np.ascontiguousarray(turning))[0]
     np.testing.assert_array_equal(got, want)
     assert got.shape == (20, 6, 3)

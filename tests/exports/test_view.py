@@ -119,6 +119,32 @@ def test_page_in_browser(browser, tmp_path, which):
     page.close()
 
 
+def test_page_with_a_slide_and_a_helix(browser, tmp_path):
+    """A P-pair's slider is in metres (shown in mm, a thousandth of its range per step), an H-pair's
+    in radians; the page's kinematics of both equal chain.fk."""
+    chain = apair.AChain(
+        [apair.APair.revolute(), apair.APair.prismatic(), apair.APair.helical(0.02)],
+        a=[0.3, 0.0, 0.1],
+        alpha=[0.0, np.pi / 2, 0.0],
+        offset=[0.2, 0.0, 0.05],
+        theta_offset=[0.0, 0.4, 0.0],
+        limits=[None, (0.05, 0.25), None],
+    )
+    page, errors, _ = open_page(browser, view.write(chain, tmp_path / "slides.html"))
+    assert page.get_attribute("#q2", "step") == repr((0.25 - 0.05) / 1000)
+    page.focus("#q2")
+    page.keyboard.press("End")
+    q = np.array(page.evaluate("apairView.q()"))
+    assert q[1] == 0.25 and page.text_content("#q2-value") == "250.0 mm"
+    assert np.abs(shown_pose(page) - chain.fk(q)).max() < 1e-12
+    rng = np.random.default_rng(6)
+    for qs in rng.uniform(chain.limits[:, 0], chain.limits[:, 1], (20, 3)):
+        js = np.array(page.evaluate("qs => apairView.fk(qs)", qs.tolist())).reshape(4, 4)
+        assert np.abs(js - chain.fk(qs)).max() < 1e-12
+    assert errors == []
+    page.close()
+
+
 def test_page_is_self_contained(tmp_path):
     html = mixed_chain().to_html()
     assert "<script src" not in html and "<link" not in html and "http://" not in html and "https://" not in html

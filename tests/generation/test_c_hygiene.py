@@ -474,9 +474,9 @@ def test_a_program_links_only_the_kernels_it_calls(tmp_path):
     internal = lambda k: [f"apair_internal_{k}_core", f"apair_internal_{k}_invariants"]
     public = lambda k: [f"apair_{k}", f"apair_{k}_batch", f"apair_{k}_core", f"apair_{k}_invariants"]
     cases = {
-        "apair_inverse_dynamics4(law, qd, qdd, dh, links, legs, g, out);": public("inverse_dynamics4")
+        "apair_inverse_dynamics4(law, qd, qdd, dh, turning, links, legs, g, out);": public("inverse_dynamics4")
         + internal("inverse_dynamics4"),
-        "apair_forward_dynamics4(law, qd, qdd, dh, links, legs, g, out);": public("forward_dynamics4")
+        "apair_forward_dynamics4(law, qd, qdd, dh, turning, links, legs, g, out);": public("forward_dynamics4")
         + internal("inverse_dynamics4")
         + internal("mass_matrix4")
         + public("inverse_dynamics4")
@@ -486,7 +486,8 @@ def test_a_program_links_only_the_kernels_it_calls(tmp_path):
         program = tmp_path / "prog.c"
         program.write_text(
             '#include "apair.h"\nint main(void)\n{\n    double law[20] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, '
-            "1, 0, 0, 0, 0}, qd[4] = {0}, qdd[4] = {0}, dh[16] = {0}, links[40] = {0}, legs[12] = {0}, "
+            "1, 0, 0, 0, 0}, qd[4] = {0}, qdd[4] = {0}, dh[16] = {0}, turning[4] = {1, 1, 1, 1}, links[40] = {0}, "
+            "legs[12] = {0}, "
             "g[3] = {0, 0, -9.81}, out[4];\n    int i;\n    for (i = 0; i < 4; ++i) {\n"
             "        links[10 * i] = links[10 * i + 4] = links[10 * i + 5] = links[10 * i + 6] = 1.0;\n    }\n"
             f"    {call}\n    return out[0] != out[0];\n}}\n"

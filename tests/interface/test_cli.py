@@ -146,10 +146,10 @@ def test_error_exits(capsys, argv, command, message):
 
 def test_bad_chain_file(capsys, tmp_path):
     path = tmp_path / "bad.toml"
-    path.write_text('[[joint]]\npair = "helical"\na = 0.1\nalpha = 0\n')
+    path.write_text('[[joint]]\npair = "spiral"\na = 0.1\nalpha = 0\n')
     code, out, err = run(capsys, "fk", path, "0.1")
     assert code == 2 and out == ""
-    assert "joint 1.pair" in err and "helical" in err
+    assert "joint 1.pair" in err and "spiral" in err
 
 
 def test_module_entry_point():

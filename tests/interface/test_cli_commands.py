@@ -295,7 +295,8 @@ def test_kernels_counts_per_item_with_the_callees(capsys):
     assert [r.split()[0] for r in rows] == sorted(kernels)
     for row in rows:
         name, count = row.split()[:2]
-        assert int(count) == kernels[name]["ops_per_item"] > 0, row
+        assert int(count) == kernels[name]["ops_per_item"], row
+        assert int(count) > 0 or name == "law_prismatic", row  # a slide's law values are copies
     bias6 = next(r for r in rows if r.startswith("bias6 "))
     assert "composite" in bias6
     assert "composite" not in next(r for r in rows if r.startswith("fk6 "))

@@ -334,7 +334,7 @@ GOOD = joints(SIN + "a = 0.3\nalpha_deg = 90\noffset = 0.1\n", GEN + "a = 0.25\n
     [
         ("[[joint]\n", r": not valid TOML: .* \(line 1, column 8\)$"),
         ('name = "x"\nfoo = 1\n' + GOOD, r": unknown key foo$"),
-        (joints('pair = "helical"\na = 0.1\nalpha = 0\n'), r"joint 1\.pair: .*'helical'"),
+        (joints('pair = "spiral"\na = 0.1\nalpha = 0\n'), r"joint 1\.pair: .*'spiral'"),
         (joints("a = 0.1\nalpha = 0\n"), r"joint 1\.pair: .*None"),
         (
             joints('pair = "revolute"\nbase_radius = 0.05\na = 0.1\nalpha = 0\n'),

@@ -151,7 +151,7 @@ def test_anything_not_canonical_returns_none():
             ValueError,
         ),
         ({0: np.zeros(7, np.int32)}, ValueError),
-        ({0: np.array([0, 3, 0], np.int32)}, ValueError),
+        ({0: np.array([0, 5, 0], np.int32)}, ValueError),
         ({1: np.zeros((3, 3))}, ValueError),
         ({2: np.zeros((2, 4))}, ValueError),
         ({3: np.zeros(2)}, ValueError),

@@ -82,7 +82,10 @@ def test_apair_option(run, tmp_path) -> None:
     ("spec", "message"),
     [
         ("2", r"--apair: expected K:KIND\[,key=value,\.\.\.\] \(e\.g\. 2:sinusoidal,base_radius=0\.06\), got '2'"),
-        ("2:spiral", r"--apair 2:spiral: unknown pair kind 'spiral' \(one of sinusoidal, general, revolute\)"),
+        (
+            "2:spiral",
+            r"--apair 2:spiral: unknown pair kind 'spiral' \(one of sinusoidal, general, revolute, helical, prismatic\)",
+        ),
         ("2:sinusoidal,base_radius", r"--apair 2:sinusoidal,base_radius: expected key=value, got 'base_radius'"),
         ("2:sinusoidal,base_radius=x", r"--apair 2:sinusoidal,base_radius=x: base_radius: expected a number, got 'x'"),
         ("2:sinusoidal,base_radius=inf", r"base_radius: expected a finite number, got 'inf'"),

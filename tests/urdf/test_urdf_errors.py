@@ -26,7 +26,6 @@ def _refused(match: str, *args, **kwargs) -> None:
 @pytest.mark.parametrize(
     ("kind", "extra", "message"),
     [
-        ("prismatic", "", r"joint 'j2' is prismatic: prismatic pairs are not yet supported$"),
         ("floating", "", r"joint 'j2' is floating: a floating joint has more than one degree of freedom"),
         ("planar", "", r"joint 'j2' is planar: a planar joint has more than one degree of freedom"),
         ("revolute", '<mimic joint="j1" multiplier="2"/>', r"joint 'j2' mimics joint 'j1': mimic joints on the path"),
@@ -60,7 +59,7 @@ def test_links_and_paths_refused(tmp_path) -> None:
         "l1",
         base="l2",
     )
-    _refused(r"^tip: no revolute or continuous joint between links 'l1' and 'l1'$", path, "l1", base="l1")
+    _refused(r"^tip: no revolute, continuous or prismatic joint between links 'l1' and 'l1'$", path, "l1", base="l1")
     with pytest.raises(ValueError, match=r"^tip: expected a link name \(a str\), got int$"):
         convert(path, 3)  # type: ignore[arg-type]
 

@@ -11,7 +11,15 @@ from ...ir import Lowered
 from ...templating import Templates, TemplateSource
 
 TEMPLATES = Templates(Path(__file__).parent / "templates")
-WEB_KERNELS = ("law_revolute", "law_sinusoidal", "law_general", "fk1", "pair_legs")  # lowered with JavaScript too
+WEB_KERNELS = (
+    "law_revolute",
+    "law_sinusoidal",
+    "law_general",
+    "law_helical",
+    "law_prismatic",
+    "fk1",
+    "pair_legs",
+)  # lowered with JavaScript too
 
 
 def render(kernels: list[Lowered], template: TemplateSource = TEMPLATES) -> dict[str, str]:

@@ -61,7 +61,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
             outside_limits=args.outside_limits,
         )
         path = write_text(out, xml, args.force, ".xml")
-    legs = sum(6 for p in chain.pairs if p.kind != "revolute")
+    legs = sum(6 for p in chain.pairs if p.is_apair)
     print(
         f"{chain.name}: MuJoCo model written to {path} ({chain.n} pairs, {legs} legs closed by "
         f"{legs} connect constraints; keyframe 0 at q = {np.round(q if q is not None else np.zeros(chain.n), 6).tolist()})"

@@ -172,7 +172,7 @@ def _clearance_plot(args: argparse.Namespace, chain: AChain) -> dict[str, Any] |
         return None
     from ..plots import clearance
 
-    k = next((i for i, p in enumerate(chain.pairs) if p.kind != "revolute"), None)
+    k = next((i for i, p in enumerate(chain.pairs) if p.is_apair), None)
     if k is None:
         raise ValueError("file: the chain has no A-pair to plot")
     return {"joint": k + 1, "path": str(clearance(chain.pairs[k], args.plot, overwrite=args.force))}

@@ -39,7 +39,7 @@ def axial_travel(chain: Chain) -> NDArray[np.float64]:
     along its axis that an A-pair adds. d(θ) on a grid of the range with its ends and 0."""
     out = np.zeros(chain.n)
     for i, (pair, (lo, hi)) in enumerate(zip(chain.pairs, chain.limits)):
-        if pair.kind == "revolute":
+        if not pair.is_apair:  # an R-pair, or a P- or H-pair whose slide is its own
             continue
         theta = np.linspace(lo, hi, TRAVEL_GRID)
         if lo < 0 < hi:
@@ -78,7 +78,7 @@ def gravity(chain: Chain, q: NDArray[np.float64]) -> tuple[NDArray[np.float64], 
 def masses(chain: Chain) -> tuple[float, float]:
     """(total mass, the legs' mass) [kg]: the links plus six legs of leg_mass per A-pair. The plates
     have no mass of their own: the link that carries a pair's platform is its body."""
-    legs = 6.0 * sum(p.leg_mass for p in chain.pairs if p.kind != "revolute")
+    legs = 6.0 * sum(p.leg_mass for p in chain.pairs if p.is_apair)
     return float(sum(link.mass for link in chain.links) + legs), float(legs)
 
 

@@ -83,14 +83,14 @@ def name_of(chain: object) -> str:
 
 def build(chain: Chain, twin: str = "revolute") -> Chain:
     """The twin of `chain`: each A-pair replaced by an R-pair at the same DH constants and link,
-    without limits (it turns fully); an R-pair keeps its explicit limits, if any. Built by the
-    chain's base class (the last class before `object` in its MRO: AChain, also for a chain on its
-    own compiled kernels), so this module need not import apair.chain."""
+    without limits (it turns fully); an R-, H- or P-pair stays, with its explicit limits, if any.
+    Built by the chain's base class (the last class before `object` in its MRO: AChain, also for a
+    chain on its own compiled kernels), so this module need not import apair.chain."""
     kind(twin)
-    pairs = [p if p.kind == "revolute" else APair.revolute() for p in chain.pairs]
+    pairs = [APair.revolute() if p.is_apair else p for p in chain.pairs]
     hard = chain.hard_limits()
     limits = [
-        (float(lo), float(hi)) if p.kind == "revolute" and math.isfinite(lo) and math.isfinite(hi) else None
+        (float(lo), float(hi)) if not p.is_apair and math.isfinite(lo) and math.isfinite(hi) else None
         for p, (lo, hi) in zip(chain.pairs, hard)
     ]
     base = cast(Callable[..., Chain], type(chain).__mro__[-2])

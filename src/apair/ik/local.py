@@ -277,10 +277,11 @@ Design = tuple[
 
 
 def _design(chain: ChainLike) -> Design:
-    """apair_ik_local's chain: kind (0 revolute, 1 sinusoidal, 2 general) and law parameters (n, 2)
+    """apair_ik_local's chain: kind (0 revolute, 1 sinusoidal, 2 general, 3 helical, 4 prismatic) and law parameters (n, 2)
     of each pair, the DH rows, the lower and upper limits (chain.limits) and the length scale."""
     n = chain.n
-    kind = np.array([("revolute", "sinusoidal", "general").index(p.kind) for p in chain.pairs], np.int32)
+    kinds = ("revolute", "sinusoidal", "general", "helical", "prismatic")
+    kind = np.array([kinds.index(p.kind) for p in chain.pairs], np.int32)
     pair = np.zeros((n, 2))
     for i, p in enumerate(chain.pairs):
         params = p.law_kernel[1]

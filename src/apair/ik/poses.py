@@ -26,13 +26,24 @@ FLOOR_ULPS = 64  # a float32 pose is verified to this many of its ulps at least 
 def length_scale(chain) -> float:
     """The chain's size: its largest link length, offset or pair amplitude (1 where all are 0, a
     chain of R-pairs through one point). No floor: a nanometre chain is solved as a metre one."""
-    lengths = [abs(float(x)) for x in (*chain.a, *chain.offset)] + [float(p.amplitude) for p in chain.pairs]
+    lengths = [abs(float(x)) for x in (*chain.a, *chain.offset)] + list(_slides(chain, 1.0))
     return max(lengths) or 1.0
 
 
+def _slides(chain, rise: float) -> list[float]:
+    """Per joint the largest translation of its pair: `rise` times an A-pair's amplitude, |d| at
+    the ends of a P-pair's range and |pitch θ| at those of an H-pair's (chain.limits)."""
+    out = []
+    for p, (lo, hi) in zip(chain.pairs, chain.limits):
+        end = max(abs(float(lo)), abs(float(hi)))
+        out.append(end if p.kind == "prismatic" else abs(p.pitch) * end if p.kind == "helical" else rise * p.amplitude)
+    return out
+
+
 def reach_of(chain) -> float:
-    """A bound on the distance of the last frame's origin from the base: Σ |a| + |c| + 2h."""
-    return float(sum(abs(a) + abs(c) + 2 * p.amplitude for a, c, p in zip(chain.a, chain.offset, chain.pairs)))
+    """A bound on the distance of the last frame's origin from the base: Σ |a| + |c| + 2h (the
+    largest slide of a P- or H-pair for 2h)."""
+    return float(sum(abs(a) + abs(c) + s for a, c, s in zip(chain.a, chain.offset, _slides(chain, 2.0))))
 
 
 def joint_periods(chain) -> np.ndarray:

@@ -115,6 +115,16 @@ class Solver:
                     f"pairs[{i}]: a general A-pair's motion is not rational; inverse kinematics "
                     "needs sinusoidal A-pairs or R-pairs"
                 )
+            if p.kind == "helical":
+                raise ValueError(
+                    f"pairs[{i}]: a helical pair's d = pitch*theta is not algebraic in the angle's half "
+                    "tangent, so all-solutions inverse kinematics does not apply; use ik_local(T, q0)"
+                )
+            if p.kind == "prismatic":
+                raise ValueError(
+                    f"pairs[{i}]: all-solutions inverse kinematics of chains with prismatic pairs is not "
+                    "built yet; use ik_local(T, q0)"
+                )
         self.chain = chain
         self.scale = length_scale(chain)
         self.reach = reach_of(chain)

@@ -6,7 +6,11 @@ rounding): with A_i(θ_i) = Rz(θ_i + φ_i) · Tz(c_i) · Tx(a_i) · Rx(α_i),
     pose of the tip link in the base link = base · A_1(q_1) ⋯ A_n(q_n) · tool,
 
 with q_i the URDF joint angle itself (sign and zero included): DH axis z_{i−1} points along the
-URDF `<axis>` of joint i (so the angles agree in sign) and φ_i absorbs the angle's zero.
+URDF `<axis>` of joint i (so the angles agree in sign) and φ_i absorbs the angle's zero. A
+prismatic joint is a P-pair: its q_i is the URDF displacement along the same axis (c_i + q_i along
+z_{i−1}, c_i the offset at displacement 0), its angle the constant φ_i; its axis is the line along
+`<axis>` through the child link's origin (a slide has no line of its own: any parallel line moves
+the links alike, and this one is the URDF's).
 
 Frames (all at q = 0):
 
@@ -53,12 +57,12 @@ class ConvertedJoint:
     """One R-pair of the chain and where its values came from."""
 
     name: str  # the URDF joint
-    type: str  # revolute or continuous
+    type: str  # revolute, continuous or prismatic
     a: float
     alpha: float
     offset: float
     theta_offset: float
-    limits: tuple[float, float] | None  # URDF <limit lower upper> [rad]; None for continuous
+    limits: tuple[float, float] | None  # URDF <limit lower upper> [rad; m if prismatic]; None for continuous
     normal: str  # how x_i was chosen: skew, intersecting, parallel, coincident, last
     fixed: tuple[str, ...]  # fixed joints folded in before this joint (after the previous one)
     body: Body  # link i: the URDF links merged into it, mass, com and inertia in frame i
@@ -132,8 +136,6 @@ def _path(robot: Robot, base: str, tip: str) -> tuple[list[Joint], list[list[Joi
                 f"{w} mimics joint {joint.mimic!r}: mimic joints on the path from {base!r} to {tip!r} "
                 "are not supported (an apair joint is driven on its own)"
             )
-        if joint.type == "prismatic":
-            raise ValueError(f"{w} is prismatic: prismatic pairs are not yet supported")
         if joint.type in ("floating", "planar"):
             raise ValueError(
                 f"{w} is {joint.type}: a {joint.type} joint has more than one degree of freedom, which "
@@ -145,7 +147,7 @@ def _path(robot: Robot, base: str, tip: str) -> tuple[list[Joint], list[list[Joi
             moving.append(joint)
             fixed.append([])
     if not moving:
-        raise ValueError(f"tip: no revolute or continuous joint between links {base!r} and {tip!r}")
+        raise ValueError(f"tip: no revolute, continuous or prismatic joint between links {base!r} and {tip!r}")
     if len(moving) > MAX_JOINTS:
         nearest = moving[MAX_JOINTS - 1].child
         raise ValueError(

@@ -63,7 +63,7 @@ class Joint:
     child: str
     origin: Matrix  # the child link's frame in the parent link's frame at q = 0
     axis: NDArray[np.float64]  # unit vector in the child (joint) frame
-    limits: tuple[float, float] | None  # <limit lower upper> of a revolute joint
+    limits: tuple[float, float] | None  # <limit lower upper> of a revolute [rad] or prismatic [m] joint
     mimic: str | None  # the joint it mimics, if any
 
 
@@ -186,14 +186,18 @@ def _joint(where: str, el: ET.Element, links: dict[str, Inertial | None]) -> Joi
     if kind in ("revolute", "continuous", "prismatic") and not norm > 0:
         raise ValueError(f"{w} <axis xyz>: the axis is the zero vector")
     limits = None
-    if kind == "revolute":
+    if kind in ("revolute", "prismatic"):
         lim = el.find("limit")
         if lim is None:
-            raise ValueError(f"{w}: a revolute joint needs <limit lower=... upper=...> (use continuous for none)")
+            raise ValueError(
+                f"{w}: a {kind} joint needs <limit lower=... upper=...>"
+                + (" (use continuous for none)" if kind == "revolute" else "")
+            )
         lo = float(_floats(f"{w} <limit lower>", lim.get("lower"), 1, (0.0,))[0])
         hi = float(_floats(f"{w} <limit upper>", lim.get("upper"), 1, (0.0,))[0])
         if not lo < hi:
-            raise ValueError(f"{w} <limit>: expected lower < upper, got lower={lo:g}, upper={hi:g} rad")
+            unit = "rad" if kind == "revolute" else "m"
+            raise ValueError(f"{w} <limit>: expected lower < upper, got lower={lo:g}, upper={hi:g} {unit}")
         limits = (lo, hi)
     mimic_el = el.find("mimic")
     mimic = None if mimic_el is None else (mimic_el.get("joint") or "?")

@@ -19,6 +19,8 @@ PAIR_KEYS = {
     "sinusoidal": ("base_radius", "platform_radius", "leg_mass", "leg_radius", "thickness"),
     "general": ("base_radius", "platform_radius", "leg_length", "leg_mass", "leg_radius", "thickness"),
     "revolute": (),
+    "helical": ("pitch",),
+    "prismatic": (),
 }
 RANGE_KEYS = ("limits", "limits_deg")
 _NORMAL = {
@@ -43,6 +45,8 @@ def _limits(joint: ConvertedJoint) -> dict[str, list[float]]:
     if joint.limits is None:
         return {}
     lo, hi = joint.limits
+    if joint.type == "prismatic":  # metres
+        return {"limits": [lo, hi]}
     if max(abs(lo), abs(hi)) > TURN:  # beyond a turn: the radians key would be refused as degrees
         return {"limits_deg": [math.degrees(lo), math.degrees(hi)]}
     return {"limits": [lo, hi]}
@@ -82,12 +86,13 @@ def joint_tables(conv: Converted, pairs: Mapping[int, Mapping[str, Any]] | None 
     chosen = check_pairs(conv, pairs)
     tables = []
     for i, joint in enumerate(conv.joints, start=1):
-        t: dict[str, Any] = {"pair": "revolute"}
+        t: dict[str, Any] = {"pair": "prismatic" if joint.type == "prismatic" else "revolute"}
         spec = chosen.get(i, {})
         t.update({k: v for k, v in spec.items() if k not in RANGE_KEYS})
         t.update(a=joint.a, alpha=joint.alpha, offset=joint.offset, theta_offset=joint.theta_offset)
         ranges = {k: v for k, v in spec.items() if k in RANGE_KEYS and v is not None}
-        t.update(ranges if any(k in spec for k in RANGE_KEYS) else _limits(joint))
+        same_unit = (t["pair"] == "prismatic") == (joint.type == "prismatic")  # a range in m or in rad
+        t.update(ranges if any(k in spec for k in RANGE_KEYS) else _limits(joint) if same_unit else {})
         body = joint.body
         t["mass"] = body.mass
         if body.mass > 0 or np.any(body.inertia):
@@ -138,9 +143,9 @@ def text(conv: Converted, pairs: Mapping[int, Mapping[str, Any]] | None = None) 
         fixed = f"; fixed joints folded in before it: {', '.join(joint.fixed)}" if joint.fixed else ""
         lines.append(f"[[joint]]  # joint {i}: URDF joint {joint.name} ({joint.type}){fixed}")
         kind = t["pair"]
+        own = "prismatic" if joint.type == "prismatic" else "revolute"
         lines.append(
-            f"pair = {_string(kind)}"
-            + ("" if kind == "revolute" else "  # --apair: replaces the URDF's revolute joint")
+            f"pair = {_string(kind)}" + ("" if kind == own else f"  # --apair: replaces the URDF's {joint.type} joint")
         )
         for key in PAIR_KEYS[kind]:
             if key in t:
@@ -149,9 +154,8 @@ def text(conv: Converted, pairs: Mapping[int, Mapping[str, Any]] | None = None) 
         lines.append(f"a = {_num(t['a'])}  # m; {normal}")
         lines.append(f"alpha = {_num(t['alpha'])}  # rad, from z{i - 1} to z{i} about x{i}")
         lines.append(f"offset = {_num(t['offset'])}  # m, along z{i - 1} to the foot of x{i}")
-        lines.append(
-            f"theta_offset = {_num(t['theta_offset'])}  # rad: the angle from x{i - 1} to x{i} at URDF angle 0"
-        )
+        zero = "at URDF displacement 0" if joint.type == "prismatic" else "at URDF angle 0"
+        lines.append(f"theta_offset = {_num(t['theta_offset'])}  # rad: the angle from x{i - 1} to x{i} {zero}")
         for key in RANGE_KEYS:
             if key in t:
                 source = (
