@@ -51,7 +51,8 @@ class States:
 
 
 def write_inputs(path: Path, chain, states: States) -> None:
-    """count, n, then q, qd, qdd, tau, dh, links, legs, gravity, law parameters (n) as doubles."""
+    """count, n, then q, qd, qdd, tau, dh, turning, links, legs, gravity (in frame 0), law
+    parameters (n) as doubles."""
     law_param = np.array([p.law_kernel[1][0] if p.law_kernel[1] else 0.0 for p in chain.pairs])
     head = np.array([states.count, states.n], dtype=np.float64)
     parts = [
@@ -61,21 +62,135 @@ def write_inputs(path: Path, chain, states: States) -> None:
         states.qdd,
         states.tau,
         chain._dh,
+        chain._turning,
         chain._links,
         chain._legs,
-        chain.gravity,
+        chain._gravity,  # in the DH base frame (frame 0): Rbᵀ·g, what the kernels take
         law_param,
     ]
     np.concatenate([np.ascontiguousarray(p, dtype=np.float64).ravel() for p in parts]).tofile(path)
 
 
+PIN_AXES = {"JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2, "JointModelRevoluteUnaligned": 3}
+
+
+def write_pin_model(path: Path, model, frame: str) -> None:
+    """A Pinocchio model of revolute joints (pinocchio.Model, built in Python from DH constants or a
+    URDF) for bench/peers/pinocchio_timing.cpp, which rebuilds it: per joint its type (PIN_AXES),
+    axis, parent, placement and body inertia; then the frame `frame` (parent joint, placement) and
+    the gravity, as doubles."""
+    if not model.existFrame(frame):
+        raise ValueError(f"frame: no frame {frame!r} in the Pinocchio model")
+    rows: list[np.ndarray] = [np.array([model.njoints - 1.0])]
+    for j in range(1, model.njoints):
+        joint = model.joints[j]
+        kind = PIN_AXES.get(joint.shortname())
+        if kind is None or joint.nq != 1 or joint.idx_v != j - 1:
+            raise ValueError(f"model: joint {model.names[j]} is not a revolute joint in chain order")
+        axis = np.asarray(joint.extract().axis, dtype=float) if kind == 3 else np.eye(3)[kind]
+        M, body = model.jointPlacements[j], model.inertias[j]
+        rows += [np.array([kind]), axis, np.array([model.parents[j]]), M.rotation.ravel(), M.translation]
+        rows += [np.array([body.mass]), body.lever, np.asarray(body.inertia).ravel()]
+    f = model.frames[model.getFrameId(frame)]
+    rows += [np.array([f.parentJoint]), f.placement.rotation.ravel(), f.placement.translation]
+    rows.append(np.asarray(model.gravity.linear, dtype=float))
+    np.concatenate([np.asarray(r, dtype=np.float64).ravel() for r in rows]).tofile(path)
+
+
 PEERS = ROOT / "bench" / "peers"  # bench_inputs.h: the input file's reader, shared by every program
+
+
+FRAME_TOL = 1e-12  # a base or tool frame (or the tool's offset) closer than this to the identity is not applied
+
+
+def _c_array(name: str, values) -> str:
+    return f"static const double {name}[{len(values)}] = {{{', '.join(repr(float(v)) for v in values)}}};"
+
+
+def frames_code(chain) -> tuple[str, dict[str, str], dict]:
+    """The C a user of the generic kernels writes to get the tool's pose and Jacobian in the world
+    from a chain with base and tool frames (what AChain.fk and AChain.jacobian do in Python):
+    (definitions, {op: code run after the op's batch call, inside the timing}, a description).
+    fk: base · T · tool; Jacobian: v + ω × (R_n · tool offset), then both row blocks rotated by the
+    base (R_n from the fk kernel, called for it). Frames within FRAME_TOL of the identity are skipped."""
+    n = chain.n
+    B, T = (np.eye(4) if m is None else m for m in (chain._base_T, chain._tool_T))
+    base_rot = bool(np.abs(B[:3, :3] - np.eye(3)).max() > FRAME_TOL)
+    base_move = base_rot or bool(np.abs(B[:3, 3]).max() > FRAME_TOL)
+    tool_move = bool(np.abs(T - np.eye(4)).max() > FRAME_TOL)
+    offset = bool(np.abs(T[:3, 3]).max() > FRAME_TOL)
+    about = {"base_applied": base_move, "tool_applied": tool_move, "tool_offset_applied": offset}
+    defs = [_c_array("BASE", B.ravel()), _c_array("TOOL", T.ravel()), _c_array("TOFF", T[:3, 3])]
+    defs.append("""static double *SCRATCH;
+static void rigid(const double *A, const double *B, double *C) /* C = A B, rigid 4 x 4 */
+{
+    int r, c;
+    for (r = 0; r < 3; ++r)
+        for (c = 0; c < 4; ++c)
+            C[4 * r + c] = A[4 * r] * B[c] + A[4 * r + 1] * B[4 + c] + A[4 * r + 2] * B[8 + c] + (c == 3 ? A[4 * r + 3] : 0.0);
+    C[12] = C[13] = C[14] = 0.0;
+    C[15] = 1.0;
+}""")
+    post: dict[str, str] = {}
+    if base_move or tool_move:
+        steps = []
+        if base_move:
+            steps.append("rigid(BASE, F, A); for (i = 0; i < 16; ++i) F[i] = A[i];")
+        if tool_move:
+            steps.append("rigid(F, TOOL, A); for (i = 0; i < 16; ++i) F[i] = A[i];")
+        post["fk"] = f"""{{
+            long k;
+            int i;
+            double A[16];
+            for (k = 0; k < COUNT; ++k) {{
+                double *F = OUT_fk + 16 * k;
+                {" ".join(steps)}
+            }}
+        }}"""
+    if offset or base_rot:
+        fk_call = f"apair_fk{n}_batch((size_t)COUNT, LAW, {5 * n}, DH, 0, SCRATCH);" if offset else ""
+        shift = (
+            """const double *F = SCRATCH + 16 * k;
+                double r[3];
+                for (i = 0; i < 3; ++i) r[i] = F[4 * i] * TOFF[0] + F[4 * i + 1] * TOFF[1] + F[4 * i + 2] * TOFF[2];
+                for (c = 0; c < N; ++c) {
+                    const double w0 = J[3 * N + c], w1 = J[4 * N + c], w2 = J[5 * N + c];
+                    J[c] += w1 * r[2] - w2 * r[1];
+                    J[N + c] += w2 * r[0] - w0 * r[2];
+                    J[2 * N + c] += w0 * r[1] - w1 * r[0];
+                }"""
+            if offset
+            else ""
+        )
+        rotate = (
+            """for (c = 0; c < N; ++c)
+                    for (b = 0; b < 6; b += 3) {
+                        const double x = J[b * N + c], y = J[(b + 1) * N + c], z = J[(b + 2) * N + c];
+                        for (i = 0; i < 3; ++i) J[(b + i) * N + c] = BASE[4 * i] * x + BASE[4 * i + 1] * y + BASE[4 * i + 2] * z;
+                    }"""
+            if base_rot
+            else ""
+        )
+        post["jacobian"] = f"""{fk_call}
+        {{
+            long k;
+            int i, c, b;
+            (void)b;
+            for (k = 0; k < COUNT; ++k) {{
+                double *J = OUT_jacobian + 6 * N * k;
+                {shift}
+                {rotate}
+            }}
+        }}"""
+    return "\n".join(defs), post, about
 
 
 def apair_program(chain) -> str:
     """C source timing the generated kernels for `chain` (its pairs' law kernels are fixed here,
-    the design is read at run time)."""
+    the design is read at run time; the base and tool frames, if any, are applied to fk and the
+    Jacobian as frames_code writes them)."""
     n = chain.n
+    frame_defs, frame_post, _ = frames_code(chain)
     law_calls = []
     for i, p in enumerate(chain.pairs):
         kernel, params = p.law_kernel
@@ -88,18 +203,21 @@ def apair_program(chain) -> str:
         call_inputs = [f"LAW, {5 * n}"]
         for name in extra:
             call_inputs.append(f"{name.upper()}, {n}")
-        design = {"fk": ["DH, 0"], "jacobian": ["DH, 0"], "mass_matrix": ["DH, 0", "LINKS, 0", "LEGS, 0"]}.get(
-            op, ["DH, 0", "LINKS, 0", "LEGS, 0", "GRAV, 0"]
-        )
+        design = {
+            "fk": ["DH, 0"],
+            "jacobian": ["DH, 0", "TURN, 0"],
+            "mass_matrix": ["DH, 0", "TURN, 0", "LINKS, 0", "LEGS, 0"],
+        }.get(op, ["DH, 0", "TURN, 0", "LINKS, 0", "LEGS, 0", "GRAV, 0"])
         ops_code.append(
             (op, f"apair_{stem}{n}_batch((size_t)COUNT, {', '.join(call_inputs + design)}, OUT_{op});", size(n))
         )
     body = []
-    for _op, call, _size in ops_code:
+    for op, call, _size in ops_code:
         body.append(f"""
         t0 = now_ns();
         laws_all();
         {call}
+        {frame_post.get(op, "")}
         t = (now_ns() - t0) / COUNT;
         if (round > 0 && t < best[{len(body)}]) best[{len(body)}] = t;""")
     names = [op for op, _, _ in ops_code]
@@ -120,6 +238,7 @@ def apair_program(chain) -> str:
 
 static double *LAW;
 {outs}
+{frame_defs}
 
 static void laws_all(void)
 {{
@@ -149,6 +268,7 @@ int main(int argc, char **argv)
     FILE *f;
     if (argc < 4 || read_inputs(argv[1])) return 2;
     LAW = (double *)malloc(sizeof(double) * COUNT * {5 * n});
+    SCRATCH = (double *)malloc(sizeof(double) * COUNT * 16);
     {allocs}
     for (k = 0; k < {len(names) + 2}; ++k) best[k] = 1e300;
     for (round = 0; round <= atoi(argv[3]); ++round) {{{"".join(body)}
@@ -267,9 +387,9 @@ def cached(exe: Path, key: list[str], build) -> Path:
     return exe
 
 
-def run_program(exe: Path, inputs: Path, outputs: Path, rounds: int) -> dict:
+def run_program(exe: Path, inputs: Path, outputs: Path, rounds: int, extra: tuple[str, ...] = ()) -> dict:
     res = subprocess.run(
-        pinned([str(exe), str(inputs), str(outputs), str(rounds)]), check=True, capture_output=True, text=True
+        pinned([str(exe), str(inputs), str(outputs), str(rounds), *extra]), check=True, capture_output=True, text=True
     )
     return json.loads(res.stdout)
 
@@ -480,20 +600,41 @@ def _agreement(ref: dict, got: dict) -> dict:
 
 
 def compare(
-    chain, states: States, workdir: Path, opts=("-O2", "-O3"), rounds: int = 7, peers: bool = True, log=print
+    chain,
+    states: States,
+    workdir: Path,
+    opts=("-O2", "-O3"),
+    rounds: int = 7,
+    peers: tuple[str, ...] = ("pinocchio", "casadi"),
+    log=print,
+    pin_model=None,
+    pin_frame: str = "end",
+    specialised: bool = True,
 ) -> dict:
     """Every tool on `chain` and `states` at each optimisation level: agreement with apair first,
     then `rounds` round-robin rounds (each program evaluates every operation over all poses once
-    per round); the minimum ns per evaluation over the rounds. apair runs twice: its generic
-    kernels ("apair") and the chain's own specialised code ("apair_specialised")."""
+    per round); the minimum ns per evaluation over the rounds. apair runs with its generic kernels
+    ("apair") and, if `specialised`, the chain's own specialised code ("apair_specialised").
+    `peers`: "pinocchio" (its C++ on `pin_model`, a pinocchio.Model of the same chain whose joints
+    are in chain order, timing the frame `pin_frame`: the tool's, as apair's fk and Jacobian give
+    it), "casadi" (its C code of Pinocchio's algorithms on the DH chain of the input file)."""
+    unknown = set(peers) - {"pinocchio", "casadi"}
+    if unknown:
+        raise ValueError(f"peers: unknown {sorted(unknown)}; known: pinocchio, casadi")
+    if "pinocchio" in peers and pin_model is None:
+        raise ValueError("pin_model: a pinocchio.Model is needed to time Pinocchio")
     workdir.mkdir(parents=True, exist_ok=True)
     n = chain.n
     inputs = workdir / f"inputs{n}.bin"
     write_inputs(inputs, chain, states)
     tools: dict[str, Path] = {}
-    result: dict = {"n": n, "count": states.count, "tools": {}, "skipped": {}}
+    extra: dict[str, tuple[str, ...]] = {}
+    result: dict = {"n": n, "count": states.count, "tools": {}, "skipped": {}, "frames": frames_code(chain)[2]}
+    if "pinocchio" in peers:
+        model_file = workdir / "pin_model.bin"
+        write_pin_model(model_file, pin_model, pin_frame)
     casadi_c = None
-    if peers:
+    if "casadi" in peers:
         try:
             log("  generating CasADi's C code from Pinocchio on casadi::SX ...")
             casadi_c = casadi_generate(workdir, inputs)
@@ -503,24 +644,26 @@ def compare(
     for opt in opts:
         log(f"  building at {opt} ...")
         tools[f"apair {opt}"] = apair_build(chain, workdir, opt)
-        tools[f"apair_specialised {opt}"] = specialised_build(chain, workdir, opt)
-        if peers:
+        if specialised:
+            tools[f"apair_specialised {opt}"] = specialised_build(chain, workdir, opt)
+        if "pinocchio" in peers:
             try:
                 tools[f"pinocchio {opt}"] = pinocchio_build(workdir, opt)
+                extra[f"pinocchio {opt}"] = (str(model_file),)
             except (RuntimeError, subprocess.CalledProcessError) as exc:
                 result["skipped"]["pinocchio"] = str(exc)
-            if casadi_c is not None:
-                tools[f"casadi_baked {opt}"] = casadi_build(workdir, casadi_c, n, False, opt)
-                tools[f"casadi_design {opt}"] = casadi_build(workdir, casadi_c, n, True, opt)
+        if casadi_c is not None:
+            tools[f"casadi_baked {opt}"] = casadi_build(workdir, casadi_c, n, False, opt)
+            tools[f"casadi_design {opt}"] = casadi_build(workdir, casadi_c, n, True, opt)
     outputs = {}
     for name, exe in tools.items():
-        run_program(exe, inputs, workdir / "out.bin", 1)
+        run_program(exe, inputs, workdir / "out.bin", 1, extra.get(name, ()))
         outputs[name] = read_outputs(workdir / "out.bin", n)
     ref = outputs[f"apair {opts[0]}"]
     best: dict[str, dict] = {name: {} for name in tools}
     for _r in range(rounds):
         for name, exe in tools.items():
-            times = run_program(exe, inputs, workdir / "out.bin", 1)
+            times = run_program(exe, inputs, workdir / "out.bin", 1, extra.get(name, ()))
             for op, t in times.items():
                 if op != "sink":
                     best[name][op] = min(best[name].get(op, np.inf), t)

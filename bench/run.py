@@ -7,7 +7,10 @@ Pinocchio's C++ compiled from its headers and CasADi's C code generated from Pin
 algorithms on casadi::SX (design baked in, and design as inputs), same gcc flags (-std=c99 or
 c++17, -O2 and -O3, -DNDEBUG, no fast-math, no -march), one pinned core, agreement checked first,
 minimum over round-robin rounds; then the A-chain case (sinusoidal pairs with leg mass), where
-no peer can follow. Then, from Python:
+no peer can follow. Before it (alone: --panda-only) the Panda of example-robot-data imported by
+apair.load_urdf (7 joints, base and tool frames) against Pinocchio's C++ on the model it builds from
+the same URDF (the fingers locked), and `apair import urdf` of it in a fresh process. Then, from
+Python:
 
 For chains of n = 2, 4, 6 joints (random DH constants and links; R-pairs, i.e. A-pairs with h = 0,
 so that Pinocchio models exactly the same chain) it times forward kinematics, the Jacobian, the
@@ -199,7 +202,13 @@ def bench_chain(n: int, rng, batch: int, single: int, slow: int, repeats: int, p
     qd = rng.normal(size=(batch, n))
     qdd = rng.normal(size=(batch, n))
     tau = rng.normal(size=(batch, n))
-    design = {"dh": chain._dh, "links": chain._links, "legs": chain._legs, "gravity": chain.gravity}
+    design = {
+        "dh": chain._dh,
+        "turning": chain._turning,
+        "links": chain._links,
+        "legs": chain._legs,
+        "gravity": chain.gravity,
+    }
     per_pose = {"law": chain._law(q), "qd": qd, "qdd": qdd, "tau": tau}
     pin_f, pin_check = pin_functions(chain) if pin_ok else ({}, {})
     specialised = chain.specialise()  # compiled once, then found in the cache
@@ -283,6 +292,7 @@ def batch_scaling(n: int, rng, repeats: int) -> dict:
                 "qd": q,
                 "qdd": q,
                 "dh": chain._dh,
+                "turning": chain._turning,
                 "links": chain._links,
                 "legs": chain._legs,
                 "gravity": chain.gravity,
@@ -376,17 +386,161 @@ def native_section(rng, quick: bool) -> dict:
             rng.normal(size=(count, n)),
         )
         print(f"compiled comparison, {label} (n = {n}, {count} states):", file=sys.stderr, flush=True)
+        peers = ("pinocchio", "casadi") if label == "R-chain" and _has_pinocchio() else ()
         out[label] = native.compare(
             chain,
             states,
             work / label,
             rounds=rounds,
-            peers=label == "R-chain",
+            peers=peers,
             log=lambda m: print(m, file=sys.stderr, flush=True),
+            pin_model=pin_model(chain) if peers else None,
         )
     manifest = kernels.manifest()["kernels"]
     out["apair_ops_per_item"] = {op: manifest[f"{op}6"]["ops_per_item"] for op in native.OPERATIONS}
     return out
+
+
+def _has_pinocchio() -> bool:
+    try:
+        import pinocchio  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+PANDA_TIP = "panda_link8"
+PANDA_JOINTS = [f"panda_joint{i}" for i in range(1, 8)]
+
+
+def panda_urdf() -> Path | None:
+    """The Panda's URDF of the example-robot-data wheel (in the cmeel prefix), or None."""
+    from bench import native
+
+    prefix = native.cmeel_prefix()
+    path = None if prefix is None else prefix / "share/example-robot-data/robots/panda_description/urdf/panda.urdf"
+    return path if path is not None and path.is_file() else None
+
+
+def panda_pin_model(path: Path):
+    """Pinocchio's model of the Panda's URDF with the joints off the arm's path (the fingers) locked
+    at their neutral value, as tests/chain7 builds it: the seven arm joints, the tip's frame."""
+    import pinocchio as pin
+
+    full = pin.buildModelFromUrdf(str(path))
+    lock = [full.getJointId(name) for name in full.names[1:] if name not in PANDA_JOINTS]
+    return pin.buildReducedModel(full, lock, pin.neutral(full))
+
+
+def time_import_urdf(path: Path, runs: int) -> dict:
+    """`apair import urdf` of the Panda, each run a fresh process (the console script next to this
+    Python, else python -m apair): min and median wall time [s]."""
+    script = Path(sys.executable).with_name("apair")
+    cmd = [str(script)] if script.is_file() else [sys.executable, "-m", "apair"]
+    times = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(runs):
+            t0 = time.perf_counter()
+            subprocess.run(
+                [
+                    *cmd,
+                    "import",
+                    "urdf",
+                    str(path),
+                    "--tip",
+                    PANDA_TIP,
+                    "--out",
+                    str(Path(tmp) / "panda.toml"),
+                    "--force",
+                ],
+                check=True,
+                capture_output=True,
+            )
+            times.append(time.perf_counter() - t0)
+    return {"runs": runs, "min_s": float(min(times)), "median_s": float(np.median(times))}
+
+
+def panda_section(rng, quick: bool) -> dict:
+    """The Panda of example-robot-data imported by apair.load_urdf (7 R-pairs, base and tool
+    frames): apair's generic C kernels against Pinocchio's C++ on the model Pinocchio builds from
+    the same URDF (fingers locked), the same states (q inside the limits), agreement first
+    (bench/native.py); and the time of `apair import urdf` of it in a fresh process."""
+    from bench import native
+
+    path = panda_urdf()
+    if path is None:
+        return {"skipped": "example-robot-data's Panda URDF is not installed: pip install '.[test]'"}
+    count, rounds, runs = (2000, 3, 3) if quick else (10_000, 7, 7)
+    chain = apair.load_urdf(path, tip=PANDA_TIP)
+    lim = chain.limits
+    n = chain.n
+    states = native.States(
+        rng.uniform(lim[:, 0], lim[:, 1], (count, n)),
+        rng.normal(size=(count, n)),
+        rng.normal(size=(count, n)),
+        rng.normal(size=(count, n)),
+    )
+    pin_ok = _has_pinocchio()
+    print(f"compiled comparison, the Panda (n = {n}, {count} states):", file=sys.stderr, flush=True)
+    out = native.compare(
+        chain,
+        states,
+        ROOT / "build" / "bench" / "panda",
+        rounds=rounds,
+        peers=("pinocchio",) if pin_ok else (),
+        log=lambda m: print(m, file=sys.stderr, flush=True),
+        pin_model=panda_pin_model(path) if pin_ok else None,
+        pin_frame=PANDA_TIP,
+        specialised=False,
+    )
+    out["urdf"] = str(path)
+    out["tip"] = PANDA_TIP
+    out["import_urdf"] = time_import_urdf(path, runs)
+    return out
+
+
+def panda_targets(panda: dict) -> list[dict]:
+    """Issue 38's: the generic kernels <= 0.5 x Pinocchio's C++ on the imported Panda, every
+    operation and opt level; `apair import urdf` of it < 1 s (fresh process, min of the runs)."""
+    out = []
+    tools = panda.get("tools", {})
+    for opt in ("-O2", "-O3"):
+        me, other = tools.get(f"apair {opt}"), tools.get(f"pinocchio {opt}")
+        if me is None or other is None:
+            continue
+        for op in OPS:
+            r = me["ns"][op] / other["ns"][op]
+            out.append({"target": f"Panda {op} {opt}: apair <= 0.5 x pinocchio", "measured": r, "met": r <= 0.5})
+    if "import_urdf" in panda:
+        t = panda["import_urdf"]["min_s"]
+        out.append({"target": "apair import urdf of the Panda < 1 s (fresh process)", "measured": t, "met": t < 1.0})
+    return out
+
+
+def print_panda(panda: dict) -> None:
+    if "skipped" in panda and "tools" not in panda:
+        print(f"\nthe Panda: skipped ({panda['skipped']})")
+        return
+    names = list(panda["tools"])
+    print(
+        f"\nthe Panda ({panda['tip']}, n = {panda['n']}, frames {panda['frames']}), ns per evaluation, ratio = apair / peer:"
+    )
+    print(f"{'':18s}" + "".join(f"{n:>17s}" for n in names))
+    for op in OPS:
+        cells = []
+        for name in names:
+            t = panda["tools"][name]["ns"][op]
+            mine = panda["tools"][f"apair {name.split()[-1]}"]["ns"][op]
+            cells.append(f"{t:8.0f}" + (f" ({mine / t:.2f})" if not name.startswith("apair") else "       "))
+        print(f"{op:18s}" + "".join(f"{c:>17s}" for c in cells))
+    worst = max(v for t in panda["tools"].values() for v in t["difference"].values())
+    print(f"largest difference from apair (relative to the largest value): {worst:.1e}")
+    for tool, why in panda["skipped"].items():
+        print(f"skipped {tool}: {why}")
+    r = panda["import_urdf"]
+    print(
+        f"apair import urdf (fresh process): min {r['min_s']:.3f} s, median {r['median_s']:.3f} s over {r['runs']} runs"
+    )
 
 
 def native_targets(native_res: dict) -> list[dict]:
@@ -940,6 +1094,9 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--ik-local-only", action="store_true", help="only ik_local from Python, one pose per call, against Pinocchio"
     )
+    ap.add_argument(
+        "--panda-only", action="store_true", help="only the imported Panda against Pinocchio's C++, and its import time"
+    )
     ap.add_argument("--out", type=Path, default=ROOT / "bench" / "results.json")
     args = ap.parse_args(argv)
     try:
@@ -978,6 +1135,16 @@ def main(argv=None) -> int:
         print("\ntargets (ik_local from Python):")
         for t in results["ik_local_targets"]:
             print(f"  [{'met' if t['met'] else 'MISSED'}] {t['target']}: {t['measured']:.3g}")
+        args.out.write_text(json.dumps(results, indent=1, default=_plain) + "\n")
+        print(f"written to {args.out}")
+        return 0
+    results["panda"] = panda_section(np.random.default_rng(38), args.quick)  # its own draws
+    results["panda_targets"] = panda_targets(results["panda"])
+    print_panda(results["panda"])
+    print("\ntargets (the Panda):")
+    for t in results["panda_targets"]:
+        print(f"  [{'met' if t['met'] else 'MISSED'}] {t['target']}: {t['measured']:.3g}")
+    if args.panda_only:
         args.out.write_text(json.dumps(results, indent=1, default=_plain) + "\n")
         print(f"written to {args.out}")
         return 0

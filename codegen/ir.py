@@ -80,6 +80,7 @@ class Lowered:
     hoisted: Hoisted | None  # None: nothing depends on design inputs alone
     calls: list[LoweredCall]  # kernels evaluated first (their own hoisting applies)
     js: Code | None = None  # for the JavaScript backend's kernels only (backends/js: WEB_KERNELS)
+    casadi: Code | None = None  # for the CasADi backend's kernels only (backends/casadi: SOURCES)
 
     @property
     def name(self) -> str:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import json
 
-from .backends import c, js, numpy
+from .backends import c, casadi, js, numpy
 from .ir import Lowered
 from .templating import TemplateSource
 
@@ -45,6 +45,7 @@ def render_all(
     files = dict(poly_files, **library.files)
     files.update(numpy.render(lowered, library.content_hash, **own))
     files.update(js.render(kernels, **own))
+    files.update(casadi.render(lowered, **own))
     files["__init__.py"] = INIT.format(hash=library.content_hash)
     manifest = {
         "content_hash": library.content_hash,

@@ -2,11 +2,13 @@
 
 docs/images/mujoco.png: the exported MuJoCo model after 0.2 s of free motion from keyframe 0,
 rendered off-screen by MuJoCo (MUJOCO_GL=egl); docs/images/viewer.png: `apair view`'s page in
-headless Chromium. Not part of `make`: off-screen OpenGL is not on every machine.
+headless Chromium; docs/images/optimal_swing.png: examples/optimal_swing.py (CasADi and IPOPT).
+Not part of `make`: off-screen OpenGL is not on every machine.
 """
 
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -67,4 +69,6 @@ if __name__ == "__main__":
     chain = io.load(ROOT / "examples" / "4a_chain.toml")
     mujoco_frame(chain)
     viewer_shot(chain)
-    print(f"written {OUT / 'mujoco.png'} and {OUT / 'viewer.png'}", file=sys.stderr)
+    swing = OUT / "optimal_swing.png"
+    subprocess.run([sys.executable, str(ROOT / "examples" / "optimal_swing.py"), str(swing), "--force"], check=True)
+    print(f"written {OUT / 'mujoco.png'}, {OUT / 'viewer.png'} and {swing}", file=sys.stderr)

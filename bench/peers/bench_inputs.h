@@ -10,7 +10,8 @@
 #include <stdlib.h>
 #include <time.h>
 
-static double *Q, *QD, *QDD, *TAU, DH[24], LINKS[60], LEGS[18], GRAV[3], LAWP[6];
+#define MAX_N 7 /* the generated kernels' largest chain */
+static double *Q, *QD, *QDD, *TAU, DH[4 * MAX_N], TURN[MAX_N], LINKS[10 * MAX_N], LEGS[3 * MAX_N], GRAV[3], LAWP[MAX_N];
 static long COUNT;
 static int N;
 
@@ -22,6 +23,7 @@ static int read_inputs(const char *path)
     if (!f || fread(head, sizeof(double), 2, f) != 2) return 1;
     COUNT = (long)head[0];
     N = (int)head[1];
+    if (N < 1 || N > MAX_N) return 1;
     Q = (double *)malloc(sizeof(double) * COUNT * N);
     QD = (double *)malloc(sizeof(double) * COUNT * N);
     QDD = (double *)malloc(sizeof(double) * COUNT * N);
@@ -29,7 +31,8 @@ static int read_inputs(const char *path)
     k = COUNT * N;
     if (fread(Q, sizeof(double), k, f) != (size_t)k || fread(QD, sizeof(double), k, f) != (size_t)k
         || fread(QDD, sizeof(double), k, f) != (size_t)k || fread(TAU, sizeof(double), k, f) != (size_t)k
-        || fread(DH, sizeof(double), 4 * N, f) != (size_t)(4 * N) || fread(LINKS, sizeof(double), 10 * N, f) != (size_t)(10 * N)
+        || fread(DH, sizeof(double), 4 * N, f) != (size_t)(4 * N) || fread(TURN, sizeof(double), N, f) != (size_t)N
+        || fread(LINKS, sizeof(double), 10 * N, f) != (size_t)(10 * N)
         || fread(LEGS, sizeof(double), 3 * N, f) != (size_t)(3 * N) || fread(GRAV, sizeof(double), 3, f) != 3
         || fread(LAWP, sizeof(double), N, f) != (size_t)N) return 1;
     fclose(f);

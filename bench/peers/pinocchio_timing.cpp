@@ -1,9 +1,13 @@
-// Pinocchio's C++ algorithms (double) on the chain and states of bench/native.py's input file:
+// Pinocchio's C++ algorithms (double) on the model and states of bench/native.py's input files:
 // the same round-robin timing as apair's program, the same output layout for the agreement check.
-//   pinocchio_timing INPUT OUTPUT ROUNDS
-// The chain is built from its DH constants as bench/run.py's pin_model does: revolute joints about
-// z, joint i placed at D_{i-1} = Rz(phi) Tz(c) Tx(a) Rx(alpha) of the joint before, link i's inertia
-// given in frame i (moved by D_i into joint i's frame), a frame "end" at D_n.
+//   pinocchio_timing INPUT OUTPUT ROUNDS MODEL
+// MODEL (bench/native.py's write_pin_model, from a pinocchio.Model built in Python: the DH chain's
+// or a URDF's) holds the kinematic tree as doubles: the joint count, then per joint its type (0, 1,
+// 2: revolute about x, y, z; 3: revolute about the unit axis that follows), the axis, the parent
+// joint, the placement in the parent (R row by row, then t) and the body's inertia (mass, centre of
+// mass, 3 x 3 inertia about it, in the joint's frame); then the timed frame (parent joint,
+// placement) and the gravity. The model is rebuilt here with addJoint and appendBodyToJoint, so the
+// algorithms see the model Pinocchio's own builders (DH or URDF) make.
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/frames.hpp>
@@ -12,51 +16,58 @@
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/multibody.hpp>
 
+#include <string>
 #include <vector>
 
 #include "bench_inputs.h"
 
 using namespace pinocchio;
 
-static SE3 rot(int axis, double angle)
+static SE3 placement_of(const double *p)
 {
-    Eigen::Matrix3d R = Eigen::AngleAxisd(angle, axis == 0 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitZ())
-                            .toRotationMatrix();
-    return SE3(R, Eigen::Vector3d::Zero());
+    Eigen::Matrix3d R;
+    R << p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8];
+    return SE3(R, Eigen::Vector3d(p[9], p[10], p[11]));
 }
 
-static SE3 trans(double x, double y, double z)
+static bool read_model(const char *path, Model &model, FrameIndex &fid)
 {
-    return SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(x, y, z));
-}
-
-static Model build_model()
-{
-    Model model;
-    JointIndex parent = 0;
-    SE3 placement = SE3::Identity();
-    for (int i = 0; i < N; ++i) {
-        parent = model.addJoint(parent, JointModelRZ(), placement, "r" + std::to_string(i));
-        const double a = DH[4 * i], alpha = DH[4 * i + 1], c = DH[4 * i + 2], phi = DH[4 * i + 3];
-        SE3 D = rot(2, phi) * trans(0, 0, c) * trans(a, 0, 0) * rot(0, alpha);
-        const double *L = LINKS + 10 * i;
+    FILE *f = std::fopen(path, "rb");
+    if (!f) return false;
+    std::vector<double> d;
+    double x;
+    while (std::fread(&x, sizeof(double), 1, f) == 1) d.push_back(x);
+    std::fclose(f);
+    if (d.empty()) return false;
+    const int joints = (int)d[0];
+    const size_t per_joint = 1 + 3 + 1 + 12 + 1 + 3 + 9, size = 1 + joints * per_joint + 13 + 3;
+    if (joints != N || d.size() != size) return false;
+    const double *p = d.data() + 1;
+    for (int j = 0; j < joints; ++j, p += per_joint) {
+        const int type = (int)p[0];
+        const Eigen::Vector3d axis(p[1], p[2], p[3]);
+        JointModel joint = type == 0   ? JointModel(JointModelRX())
+                           : type == 1 ? JointModel(JointModelRY())
+                           : type == 2 ? JointModel(JointModelRZ())
+                                       : JointModel(JointModelRevoluteUnaligned(axis));
+        const JointIndex id = model.addJoint((JointIndex)p[4], joint, placement_of(p + 5), "j" + std::to_string(j));
         Eigen::Matrix3d I;
-        I << L[4], L[7], L[8], L[7], L[5], L[9], L[8], L[9], L[6];
-        model.appendBodyToJoint(parent, D.act(Inertia(L[0], Eigen::Vector3d(L[1], L[2], L[3]), I)), SE3::Identity());
-        placement = D;
+        I << p[21], p[22], p[23], p[24], p[25], p[26], p[27], p[28], p[29];
+        model.appendBodyToJoint(id, Inertia(p[17], Eigen::Vector3d(p[18], p[19], p[20]), I), SE3::Identity());
     }
-    model.addFrame(Frame("end", parent, 0, placement, OP_FRAME));
-    model.gravity = Motion(Eigen::Vector3d(GRAV[0], GRAV[1], GRAV[2]), Eigen::Vector3d::Zero());
-    return model;
+    fid = model.addFrame(Frame("end", (JointIndex)p[0], 0, placement_of(p + 1), OP_FRAME));
+    model.gravity = Motion(Eigen::Vector3d(p[13], p[14], p[15]), Eigen::Vector3d::Zero());
+    return true;
 }
 
 int main(int argc, char **argv)
 {
-    if (argc < 4 || read_inputs(argv[1])) return 2;
+    if (argc < 5 || read_inputs(argv[1])) return 2;
     const int rounds = std::atoi(argv[3]);
-    Model model = build_model();
+    Model model;
+    FrameIndex fid = 0;
+    if (!read_model(argv[4], model, fid)) return 3;
     Data data(model);
-    const FrameIndex fid = model.getFrameId("end");
     const int n = N;
     const long checked = COUNT < 16 ? COUNT : 16;
     std::vector<double> outT(16 * checked), outJ(6 * n * checked), outM(n * n * checked), outTau(n * checked),

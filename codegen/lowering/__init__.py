@@ -4,7 +4,8 @@
 2. cse.py      common-subexpression elimination over the steps and outputs, and the clean-up after it;
 3. order.py    each CSE temporary placed just before its first use;
 4. hoist.py    what depends on the design inputs alone, split off for the C backend's batches;
-5. printing.py the code printed by the backends' printers (C, NumPy; JavaScript for the viewer).
+5. printing.py the code printed by the backends' printers (C, NumPy; JavaScript for the viewer;
+   CasADi for the pair laws and chain kernels).
 
 Lowering is the expensive part of code generation and is independent per kernel, so
 codegen/__main__.py runs it in worker processes; its result (codegen/ir.py) is plain data.
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..backends.casadi import SOURCES as CASADI_SOURCES
 from ..backends.js import WEB_KERNELS
 from ..ir import KernelSpec, Lowered, Signature, bare
 from . import printing
@@ -57,6 +59,16 @@ def lower(spec: KernelSpec) -> Lowered:
         if spec.calls:
             raise ValueError(f"{spec.name}: a web kernel cannot call other kernels")
         js = printing.code(printing.JS, assignments, outputs)
+    casadi = printing.code(printing.CASADI, assignments, outputs) if spec.source in CASADI_SOURCES else None
     return Lowered(
-        signature, slots(spec.inputs, local, used), code["c"], code["py"], ops, spec.fingerprint(), hoisted, calls, js
+        signature,
+        slots(spec.inputs, local, used),
+        code["c"],
+        code["py"],
+        ops,
+        spec.fingerprint(),
+        hoisted,
+        calls,
+        js,
+        casadi,
     )

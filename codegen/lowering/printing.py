@@ -1,15 +1,18 @@
 """Lowering pass 5, printing: the straight-line code as text of each target, by the backends'
-printers (C and NumPy for every kernel, JavaScript for the browser viewer's kernels)."""
+printers (C and NumPy for every kernel, JavaScript for the browser viewer's kernels, CasADi for
+the pair laws and the chain kernels)."""
 
 from __future__ import annotations
 
 from ..backends.c.printer import CPrinter
+from ..backends.casadi.printer import CasadiPrinter
 from ..backends.js.printer import JSPrinter
 from ..backends.numpy.printer import NumpyPrinter
 from ..ir import Code, KernelSpec, LoweredCall, bare
 
 PRINTERS = {"c": CPrinter(), "py": NumpyPrinter()}  # every kernel
 JS = JSPrinter()  # the kernels of backends/js (WEB_KERNELS)
+CASADI = CasadiPrinter()  # the kernels of backends/casadi (SOURCES)
 
 
 def print_assignments(printer, assignments: list) -> dict:

@@ -453,6 +453,13 @@ class AChain:
         check_frames(self)
         return SpecialisedChain(self, kernels)
 
+    def to_casadi(self) -> dict[str, Any]:
+        """{name: casadi.Function}: fk, jacobian, mass_matrix, inverse_dynamics, forward_dynamics as
+        SX graphs of the generated kernels (apair.symbolic; needs apair[casadi])."""
+        from .symbolic import to_casadi
+
+        return to_casadi(self)
+
     def to_mjcf(
         self,
         q: ArrayLike | None = None,

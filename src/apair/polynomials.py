@@ -1,4 +1,5 @@
-"""The derived polynomial sets in generated/polynomials, loaded back as sympy objects."""
+"""The derived polynomial sets in generated/polynomials, loaded back as sympy objects (sympy is
+imported by `load` only)."""
 
 from __future__ import annotations
 
@@ -6,12 +7,12 @@ import json
 from functools import cache
 from importlib import resources
 from importlib.resources.abc import Traversable
-from typing import Any
-
-import sympy as sp
-from sympy.parsing.sympy_parser import parse_expr
+from typing import TYPE_CHECKING, Any
 
 from ._validate import shorten
+
+if TYPE_CHECKING:
+    import sympy as sp
 
 
 def _dir() -> Traversable:
@@ -44,6 +45,9 @@ def load(name: str) -> dict[str, sp.Expr | sp.Eq]:
     Symbols carry the assumptions the derivation gave them (real, positive), so the loaded objects
     compare equal to the derived ones.
     """
+    import sympy as sp  # sympy (seconds to import) only when a set is loaded as sympy objects
+    from sympy.parsing.sympy_parser import parse_expr
+
     data = raw(name)
     local = {}
     for s, kind in data["symbols"].items():

@@ -97,7 +97,14 @@ def test_templates_sit_with_their_backend_and_stay_small():
     assert not (ROOT / "codegen" / "templates").exists()
     names = [t.name for t in BACKENDS.glob("*/templates/*.j2")]
     assert len(names) == len(set(names))  # emitter.Emitter finds them all by name
-    assert {p.parent.name for p in BACKENDS.glob("*/backend.py")} == {"c", "numpy", "js", "polynomials", "chain"}
+    assert {p.parent.name for p in BACKENDS.glob("*/backend.py")} == {
+        "c",
+        "numpy",
+        "js",
+        "polynomials",
+        "chain",
+        "casadi",
+    }
     assert chain.render_registry and polynomials.render_polynomial_set
 
 

@@ -107,3 +107,23 @@ def test_all_solutions_ik_refuses_and_ik_local_solves():
     q = np.array([0.5, -0.7, 0.12, 1.3])
     sol = chain.ik_local(chain.fk(q), q + [0.05, -0.05, 0.02, 0.05])
     assert sol.converged and np.abs(sol.q - q).max() < 1e-9
+
+
+def test_cli_states_a_slide_in_its_units(tmp_path, capsys):
+    from apair.cli import main
+
+    path = tmp_path / "scara.toml"
+    path.write_text(SCARA)
+    assert main(["limits", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "joint 3:    +0.0000 ..  +200.0000   explicit" in out and "[deg; mm for slides]" in out
+    assert main(["fk", str(path), "0.1", "0.2", "0.1", "0.3"]) == 0
+    assert "q = [0.1 0.2 0.1 0.3] rad; m for slides" in capsys.readouterr().out
+
+
+def test_compare_leaves_out_the_counts_it_cannot_make():
+    from apair.compare import metrics
+
+    chain = apair.io.loads(SCARA)
+    assert not metrics.ik_counted(chain)
+    assert metrics.ik_counts(chain, chain.limits.mean(axis=1)[None]) == (None, [], [])

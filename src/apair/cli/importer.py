@@ -9,6 +9,7 @@ import re
 import time
 from typing import Any
 
+from ..chain import MAX_JOINTS
 from ..pair import KINDS
 from . import args as A
 
@@ -96,7 +97,7 @@ def add_import(sub: Sub) -> None:
         "link) to --tip: one R-pair per revolute or continuous joint with exact DH constants (the "
         "joint angles are the URDF's), [base] and [tool] frames, and each link's mass, centre of mass "
         "and inertia merged from the URDF links it moves. Prismatic, floating, planar and mimic "
-        "joints on the path are refused, and so are paths of more than 6 joints.",
+        f"joints on the path are refused, and so are paths of more than {MAX_JOINTS} joints.",
     )
     p.add_argument("format", choices=["urdf"], help="the format (urdf: a robot's URDF file)")
     p.add_argument("file", help="the URDF file (meshes are not read)")

@@ -50,7 +50,8 @@ def _document(chain: AChain, units: dict[str, str], **values: Any) -> dict[str, 
 
 
 def _header(chain: AChain, q: NDArray[np.float64]) -> str:
-    return f"{chain.name}: {chain.n} joints, q = {q} rad (backend: {backend()})"
+    unit = "rad" if all(p.kind != "prismatic" for p in chain.pairs) else "rad; m for slides"
+    return f"{chain.name}: {chain.n} joints, q = {q} {unit} (backend: {backend()})"
 
 
 def _cmd_fk(args: argparse.Namespace) -> int:
@@ -148,18 +149,19 @@ def _cmd_limits(args: argparse.Namespace) -> int:
         {
             "joint": i + 1,
             "limits": lim[i],
-            "limits_deg": np.degrees(lim[i]),
+            "limits_deg": None if p.kind == "prismatic" else np.degrees(lim[i]),  # a slide's range is in m
             "what": "explicit" if chain._explicit_limits[i] is not None else p.collision_limits().what,
         }
         for i, p in enumerate(chain.pairs)
     ]
     plot = _clearance_plot(args, chain)
     if args.json:
-        emit({"chain": chain.name, "units": {"limits": "rad", "limits_deg": "deg"}, "joints": joints, "plot": plot})
+        units = {"limits": "rad (m for a prismatic joint)", "limits_deg": "deg (none for a prismatic joint)"}
+        emit({"chain": chain.name, "units": units, "joints": joints, "plot": plot})
         return 0
-    print(f"{chain.name}: joint ranges [deg] (explicit, or where the legs or plates first touch)")
-    for j in joints:
-        lo, hi = j["limits_deg"]
+    print(f"{chain.name}: joint ranges [deg; mm for slides] (explicit, or where the legs or plates first touch)")
+    for j, p in zip(joints, chain.pairs):
+        lo, hi = np.asarray(j["limits"]) * 1000 if p.kind == "prismatic" else j["limits_deg"]
         print(f"  joint {j['joint']}: {lo:+10.4f} .. {hi:+10.4f}   {j['what']}")
     if plot is not None:
         print(f"clearance of joint {plot['joint']} written to {plot['path']}")

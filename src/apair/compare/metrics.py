@@ -88,10 +88,16 @@ def inertia(chain: Chain, q: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.diagonal(M, axis1=-2, axis2=-1).mean(axis=0)
 
 
+def ik_counted(chain: Chain) -> bool:
+    """Whether all-solutions inverse kinematics covers the chain's pairs (R- and sinusoidal A-pairs)."""
+    return all(p.kind in ("revolute", "sinusoidal") for p in chain.pairs)
+
+
 def ik_counts(chain: Chain, q: NDArray[np.float64]) -> tuple[int | None, list[int], list[int]]:
     """(complex count at the first sample's pose, real counts and real counts inside the limits
-    at every sample's pose); None and empty lists for n > MAX_IK_JOINTS."""
-    if chain.n > MAX_IK_JOINTS or len(q) == 0:
+    at every sample's pose); None and empty lists for n > MAX_IK_JOINTS and for chains with P- or
+    H-pairs or general A-pairs, whose all-solutions inverse kinematics apair does not have."""
+    if chain.n > MAX_IK_JOINTS or len(q) == 0 or not ik_counted(chain):
         return None, [], []
     complex_count: int | None = None
     real, inside = [], []

@@ -58,7 +58,7 @@ def _span(counts: list[int]) -> str:
 
 def _ik(m: Measures) -> str:
     if not m.ik_real_counts:
-        return "- (n > 4)"
+        return "- (n > 4)" if len(m.pairs) > 4 else "- (P-, H- or general pairs)"
     return f"{m.ik_complex_count}; {_span(m.ik_real_counts)} ({_span(m.ik_real_inside_counts)} inside limits)"
 
 

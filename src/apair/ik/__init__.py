@@ -17,7 +17,30 @@ but the `make ik-counts` script `homotopy.counts`, which draws a random chain of
 
 from __future__ import annotations
 
-from .local import LocalSolution, distance, ik_local
-from .solver import Solution, Solver
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .local import LocalSolution, distance, ik_local
+    from .solver import Solution, Solver
 
 __all__ = ["LocalSolution", "Solution", "Solver", "distance", "ik_local"]
+
+
+# The public names, loaded on first access (PEP 562): the solvers pull in SciPy's LAPACK and every
+# elimination, which a module that needs only `poses` (apair.hold, apair.compare: the chain itself)
+# should not pay for at import.
+def __getattr__(name: str) -> Any:
+    module: Any
+    if name in ("LocalSolution", "distance", "ik_local"):
+        from . import local as module
+    elif name in ("Solution", "Solver"):
+        from . import solver as module
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(module, name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
