@@ -28,11 +28,14 @@ DERIVATIONS = (
     "apair_dynamics",
     "chain_kinematics",
     "chain_dynamics",
+    "chain_dynamics_derivatives",
     "chain_variety",
     "chain_ik",
     "chain_ik6r",
     "chain_ik1a5r",
 )
+# The derivations whose kernels a derivation's kernels call (`Call`): --only runs them too.
+NEEDS = {"chain_dynamics_derivatives": ("chain_dynamics",)}
 ROOT = Path(__file__).resolve().parent.parent
 # Rough cost of each job on one core [s], for scheduling the longest first.
 COST = {
@@ -41,6 +44,10 @@ COST = {
     ("chain_dynamics", 5): 28,
     ("chain_dynamics", 4): 20,
     ("chain_dynamics", "check"): 15,
+    ("chain_dynamics_derivatives", 7): 35,
+    ("chain_dynamics_derivatives", 6): 22,
+    ("chain_dynamics_derivatives", 5): 14,
+    ("chain_dynamics_derivatives", 4): 8,
     ("apair_dynamics", None): 9,
     ("apair_pair", None): 8,
     ("chain_variety", None): 7,
@@ -80,7 +87,8 @@ def main(argv=None) -> int:
     if args.jobs < 1:
         ap.error(f"--jobs: expected a positive number, got {args.jobs}")
     t_start = time.perf_counter()
-    todo = jobs(args.only or DERIVATIONS)
+    only = None if args.only is None else {m for name in args.only for m in (name, *NEEDS.get(name, ()))}
+    todo = jobs([name for name in DERIVATIONS if name in only] if only else DERIVATIONS)
     order = sorted(range(len(todo)), key=lambda i: -COST.get(todo[i], 1))
     results = [None] * len(todo)
     if args.jobs == 1:

@@ -161,7 +161,7 @@ def derive():
 
     # --- laws and their derivatives, for the kernels ---------------------------------------------
     assert LAWS["sinusoidal"][0] == d_sinus and LAWS["general"][0] == d_general
-    specs = law_specs()
+    specs = law_specs() + law_d3_specs()
     specs.append(legs_spec())
     L2_sq = sp.expand(L1**2 - L1_sq + L2**2)  # L2² from the consistency condition
     specs += design_specs(a_expr, b_expr, L2_sq, sinus_L1, h_expr)
@@ -283,6 +283,65 @@ def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
     formed in that order, which `APair.theta_limit` repeats in Python to find the last double of
     the range.
     """
+    inputs, steps, outs, (C, S) = _law_derivatives(kind, d_expr, args, (0, 1, 2))
+    return KernelSpec(
+        name=f"law_{kind}",
+        doc=(
+            f"The {kind} pair's law values at theta: cos(theta/2), sin(theta/2), d(theta) and its first two "
+            "derivatives, as the chain kernels take them."
+        ),
+        source=SOURCE,
+        inputs=inputs,
+        outputs=[
+            Arg(
+                "law",
+                (5,),
+                "(cos(theta/2), sin(theta/2), d [m], d' [m/rad], d'' [m/rad^2])",
+                exprs=(C, S) + tuple(outs),
+            )
+        ],
+        steps=steps,
+    )
+
+
+def law_d3_specs() -> list[KernelSpec]:
+    """Kernels (θ, pair constants) -> d'''(θ), the law's third derivative, of every kind.
+
+    Only the derivative kernels of the chain dynamics take it (∂τ/∂θ of the term d'' θ'² e_z). It
+    is a kernel of its own, from the same expressions in the same half-angle form, so that the law
+    kernels, and every chain kernel's law input, keep their width.
+    """
+    out = []
+    for kind, (d_expr, args) in LAWS.items():
+        inputs, steps, outs, _ = _law_derivatives(kind, d_expr, args, (3,))
+        out.append(
+            KernelSpec(
+                name=f"law_{kind}_d3",
+                doc=f"The {kind} pair's d'''(theta), the third derivative of its law, as the derivative "
+                "kernels of the chain dynamics take it.",
+                source=SOURCE,
+                inputs=inputs,
+                outputs=[Arg("dddd", (1,), "d''' [m/rad^3]", exprs=tuple(outs))],
+                steps=steps,
+            )
+        )
+    out.append(
+        KernelSpec(
+            name="law_prismatic_d3",
+            doc="The prismatic pair's d''' in its slide d (zero: d(d) = d), as the derivative kernels of the "
+            "chain dynamics take it.",
+            source=SOURCE,
+            inputs=[Arg("d", (1,), "joint slide [m]", (d,))],
+            outputs=[Arg("dddd", (1,), "d''' (0)", exprs=(sp.diff(PRISMATIC_LAW, d, 3),))],
+            steps=[],
+        )
+    )
+    return out
+
+
+def _law_derivatives(kind: str, d_expr: sp.Expr, args, orders: tuple[int, ...]):
+    """(inputs, steps, the derivatives of d_expr(θ) of the given orders in C = cos(θ/2),
+    S = sin(θ/2), (C, S)) of one kind's law kernel (see law_spec)."""
     names = {theta: "theta", h: "h", a: "a", b: "b", pitch: "pitch"}
     inputs = [
         Arg(names[s], (1,), doc, (s,))
@@ -309,7 +368,7 @@ def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
         assert e.free_symbols <= {C, S, h, a, b, *extra}, e
         return sp.factor(e)
 
-    derivs = [sp.simplify(e) for e in (d_expr, sp.diff(d_expr, theta), sp.diff(d_expr, theta, 2))]
+    derivs = [sp.simplify(sp.diff(d_expr, theta, k) if k else d_expr) for k in orders]
     steps = [(C, sp.cos(theta / 2)), (S, sp.sin(theta / 2))]
     if kind == "general":
         # d = √(a + b cos θ) as one step, the radicand formed as a + b(C² − S²), shared by d', d''
@@ -323,30 +382,13 @@ def law_spec(kind: str, d_expr: sp.Expr, args) -> KernelSpec:
         for e, ref in zip(outs, derivs):
             assert abs(sp.N(e.subs(env).subs(vals) - ref.subs(vals), 30)) < 1e-25
     elif kind == "revolute":
-        outs = [sp.S(0), sp.S(0), sp.S(0)]
+        outs = [sp.S(0) for _ in orders]
     elif kind == "helical":  # d = pitch·θ is linear in θ itself, not a function of its half angles
         outs = derivs
-        assert outs == [pitch * theta, pitch, sp.S(0)], outs
+        assert outs == [[pitch * theta, pitch, sp.S(0), sp.S(0)][k] for k in orders], outs
     else:
         outs = [in_half(e) for e in derivs]
-    return KernelSpec(
-        name=f"law_{kind}",
-        doc=(
-            f"The {kind} pair's law values at theta: cos(theta/2), sin(theta/2), d(theta) and its first two "
-            "derivatives, as the chain kernels take them."
-        ),
-        source=SOURCE,
-        inputs=inputs,
-        outputs=[
-            Arg(
-                "law",
-                (5,),
-                "(cos(theta/2), sin(theta/2), d [m], d' [m/rad], d'' [m/rad^2])",
-                exprs=(C, S) + tuple(outs),
-            )
-        ],
-        steps=steps,
-    )
+    return inputs, steps, outs, (C, S)
 
 
 def design_specs(a_expr, b_expr, L2_sq, sinus_L1, h_expr) -> list[KernelSpec]:

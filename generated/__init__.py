@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: ac1541d91be1e1ad
+Content hash: 67f7a1985ee87d5b
 """

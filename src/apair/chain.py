@@ -19,8 +19,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _validate as V
+from . import derivatives as D
 from .files import write_text
-from .frames import EYE4, check_frame, inverse
+from .frames import EYE4, FramedLocal, check_frame, inverse
 from .hold import held_ik
 from .kernels import call, native_chain
 from .link import Link
@@ -431,6 +432,14 @@ class AChain:
                 )
         return out
 
+    def inverse_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> D.Triple:
+        """(∂τ/∂θ, ∂τ/∂θ', M), each (..., n, n), [i, k] = ∂τ_i/∂x_k; exact (apair.derivatives)."""
+        return D.inverse_dynamics_derivatives(self, q, qd, qdd)
+
+    def forward_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike) -> D.Triple:
+        """(∂θ''/∂θ, ∂θ''/∂θ', M⁻¹ = ∂θ''/∂τ), each (..., n, n), at θ'' = forward_dynamics(q, qd, tau)."""
+        return D.forward_dynamics_derivatives(self, q, qd, tau)
+
     def energy(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
         """(..., 2): kinetic and potential energy (T, V) [J], legs included; V of gravity (in the
         world) is zero with every body at the origin of frame 0."""
@@ -693,7 +702,7 @@ class AChain:
         out = ik_local(plain, T, q0, tol=tol, max_iter=V.integer("max_iter", max_iter, maximum=MAX_ITER))
         if self._local_ik is None:
             fast = local_solver(plain, MAX_ITER)
-            self._local_ik = _FramedLocal(fast, self) if self._framed and fast is not None else fast
+            self._local_ik = FramedLocal(fast, self._B_inv, self._T_inv) if self._framed and fast is not None else fast
         return out
 
     def workspace(
@@ -747,21 +756,6 @@ class AChain:
         q = self._q(q)
         lim = self.limits
         return np.all((q >= lim[:, 0]) & (q <= lim[:, 1]), axis=-1)
-
-
-class _FramedLocal:
-    """ik_local's single-pose fast path of a chain with frames: the world pose T made frame n's
-    (base⁻¹·T·tool⁻¹) before the frameless chain's native call; None (the validating path) for
-    any T but a float64 4×4 array."""
-
-    def __init__(self, fast: Any, chain: AChain) -> None:
-        self._inner, self._B_inv, self._T_inv = fast.call, chain._B_inv, chain._T_inv
-
-    def call(self, T: Any, q0: Any, tol: Any, max_iter: Any) -> LocalSolution | None:
-        if type(T) is not np.ndarray or T.dtype != np.float64 or T.shape != (4, 4) or not np.isfinite(T).all():
-            return None
-        out: LocalSolution | None = self._inner(self._B_inv @ T @ self._T_inv, q0, tol, max_iter)
-        return out
 
 
 class SpecialisedChain(AChain):

@@ -1,10 +1,11 @@
 """Base and tool frames of a chain (docs/conventions.md §9): URDF's roll-pitch-yaw, the rigid
-transforms `frame` builds and `check_frame` validates, their inverse, and one DH joint's matrix
-(used where a held joint is folded into its neighbours, apair.hold)."""
+transforms `frame` builds and `check_frame` validates, their inverse, one DH joint's matrix
+(used where a held joint is folded into its neighbours, apair.hold), and ik_local's framed fast path."""
 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -77,3 +78,17 @@ def dh_matrix(a: float, alpha: float, c: float, angle: float) -> NDArray[np.floa
     return np.array(
         [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0.0, sa, ca, c], [0.0, 0.0, 0.0, 1.0]]
     )
+
+
+class FramedLocal:
+    """ik_local's single-pose fast path of a chain with frames (AChain.ik_local): the world pose T
+    made frame n's (base⁻¹·T·tool⁻¹, from the inverses B_inv, T_inv) before the frameless chain's
+    native call `fast`; None (the validating path) for any T but a finite float64 4×4 array."""
+
+    def __init__(self, fast: Any, B_inv: NDArray[np.float64], T_inv: NDArray[np.float64]) -> None:
+        self._inner, self._B_inv, self._T_inv = fast.call, B_inv, T_inv
+
+    def call(self, T: Any, q0: Any, tol: Any, max_iter: Any) -> Any:
+        if type(T) is not np.ndarray or T.dtype != np.float64 or T.shape != (4, 4) or not np.isfinite(T).all():
+            return None
+        return self._inner(self._B_inv @ T @ self._T_inv, q0, tol, max_iter)

@@ -50,7 +50,7 @@ def random_inputs(spec, rng: np.random.Generator, count: int) -> list[np.ndarray
         links[..., 1:4] = rng.uniform(-0.3, 0.3, links.shape[:-1] + (3,))
         links[..., 4:7] = rng.uniform(0.5, 2.0, links.shape[:-1] + (3,))
         links[..., 7:10] = rng.uniform(-0.05, 0.05, links.shape[:-1] + (3,))
-    if spec.name == "law_general":  # a > -b cos θ, on both sides of a = b
+    if spec.name.startswith("law_general"):  # a > -b cos θ, on both sides of a = b (its d''' kernel too)
         theta, a, b = out
         out[1] = np.abs(b) * rng.uniform(-0.9, 3.0, a.shape)
         lim = np.arccos(np.clip(-out[1] / b, -1, 1))

@@ -18,11 +18,15 @@ def module(
     hash: str,
     constants: list[tuple[str, object]] | None = None,
     template: TemplateSource = TEMPLATES,
+    imports: list[tuple[str, str]] | None = None,
 ) -> str:
-    """The text of one module of kernels (`constants`: module-level (name, value) assignments)."""
-    context = {"kernels": kernels, "source": source, "hash": hash}
+    """The text of one module of kernels (`constants`: module-level (name, value) assignments;
+    `imports`: (module stem, kernel) of the kernels of other modules that its kernels call)."""
+    context: dict[str, object] = {"kernels": kernels, "source": source, "hash": hash}
     if constants is not None:
         context["constants"] = constants
+    if imports:
+        context["imports"] = imports
     return template("kernels.py.j2")[0].render(**context)
 
 
@@ -35,11 +39,15 @@ def render(
     lowered: dict[str, list[Lowered]], library_hash: str, template: TemplateSource = TEMPLATES
 ) -> dict[str, str]:
     """{path under generated/: text} of the modules of `lowered` ({derivation module stem: its
-    kernels}) and their index (stamped with the C library's content hash)."""
-    files = {
-        f"numpy/{stem}.py": module(ks, ks[0].spec.source, module_hash(ks, template), template=template)
-        for stem, ks in lowered.items()
-    }
+    kernels}) and their index (stamped with the C library's content hash). A kernel that calls one
+    of another derivation imports it from that module."""
+    home = {k.name: stem for stem, ks in lowered.items() for k in ks}
+    files = {}
+    for stem, ks in lowered.items():
+        imports = sorted({(home[c.kernel], c.kernel) for k in ks for c in k.calls if home[c.kernel] != stem})
+        files[f"numpy/{stem}.py"] = module(
+            ks, ks[0].spec.source, module_hash(ks, template), template=template, imports=imports
+        )
     files["numpy/__init__.py"] = template("numpy_init.py.j2")[0].render(
         modules=sorted(lowered),
         kernels=sorted((k.name, stem) for stem, ks in lowered.items() for k in ks),
