@@ -122,3 +122,20 @@ def test_casadi_generates_c_of_the_chain(tmp_path):
     np.testing.assert_allclose(
         np.array(G(q, qd, qdd)).ravel(), chain.inverse_dynamics(q, qd, qdd), rtol=1e-13, atol=1e-13
     )
+
+
+@pytest.mark.parametrize("name", sorted(CHAINS))
+def test_casadi_jacobian_of_forward_dynamics_equals_the_derivative_kernels(name):
+    """CasADi differentiating its graph of forward_dynamics equals forward_dynamics_derivatives (the
+    generated derivative kernels) to 1e-9: two independent routes to the same derivatives."""
+    chain = CHAINS[name]
+    n = chain.n
+    q_, qd_, tau_ = (ca.SX.sym(s, n) for s in ("q", "qd", "tau"))
+    fd = chain.to_casadi()["forward_dynamics"](q_, qd_, tau_)
+    D = ca.Function("D", [q_, qd_, tau_], [ca.jacobian(fd, q_), ca.jacobian(fd, qd_), ca.jacobian(fd, tau_)])
+    rng = np.random.default_rng(6)
+    for q, qd, _ in states(chain, rng, 3):
+        tau = rng.normal(size=n) * 3
+        for got, ref in zip(D(q, qd, tau), chain.forward_dynamics_derivatives(q, qd, tau)):
+            got = np.array(got)
+            assert np.abs(got - ref).max() <= 1e-9 * max(1.0, np.abs(ref).max()), name
