@@ -20,6 +20,7 @@ import random
 import mpmath
 import sympy as sp
 
+from .autodiff import directional
 from .quaternions import Quaternion, StudyPoint, rotation, translation
 from .spec import Arg, Entry, KernelSpec, PolynomialSet
 
@@ -242,6 +243,44 @@ def jacobian_spec(n: int) -> KernelSpec:
     )
 
 
+def jacobian_dot_spec(n: int) -> KernelSpec:
+    """J̇ = dJ/dt along q' (6 × n): the Jacobian's steps differentiated forward along the velocity
+    (autodiff.directional): each joint's law values move by q'_i times their derivatives in q_i
+    (cos(θ/2) → −w sin(θ/2)/2, sin(θ/2) → w cos(θ/2)/2, d → d', d' → d''). J̇q' is the bias of the
+    tool's acceleration, a = J q'' + J̇ q', which operational-space control needs."""
+    inputs, J = chain_inputs(n)
+    qd = Arg(
+        "qd",
+        (n,),
+        "joint velocities q'_i [rad/s; m/s for a slide]",
+        tuple(sp.Symbol(f"qd_{i}", real=True) for i in range(1, n + 1)),
+    )
+    rec = _Recorder()
+    Jm = screw_jacobian(frames(n, J, rec), J)
+    tangent: dict = {}
+    for j, v in zip(J, qd.symbols):
+        w = j["w"]
+        for sym, rate in (
+            (j["ch"], -w * j["sh"] / 2),
+            (j["sh"], w * j["ch"] / 2),
+            (j["d"], j["dd"]),
+            (j["dd"], j["ddd"]),
+        ):
+            tangent[sym] = tangent.get(sym, 0) + rate * v
+    steps, Jdot = directional(rec.steps, list(Jm), tangent, "dJ_")
+    return KernelSpec(
+        name=f"jacobian_dot{n}",
+        doc=(
+            f"Time derivative of the geometric Jacobian (6 x {n}, base frame, rows [v; omega]) of a {n}-joint "
+            "chain moving at q': dJ/dt, with J of jacobian{n}."
+        ),
+        source=SOURCE,
+        inputs=[inputs[0], qd, inputs[1], turning_arg(J)],
+        steps=rec.steps + steps,
+        outputs=[Arg("Jdot", (6, n), "dJ/dt, row-major", exprs=tuple(Jdot))],
+    )
+
+
 def check_jacobian(n: int, samples: int = 3, digits: int = 50) -> float:
     """Max |screw Jacobian − derivative of FK| over random points, in `digits`-digit arithmetic.
 
@@ -339,5 +378,5 @@ def derive():
     checks = {n: check_jacobian(n) for n in (1, 2, 3)}
     specs = []
     for n in range(1, MAX_N + 1):
-        specs += [fk_spec(n), fk_study_spec(n), jacobian_spec(n)]
+        specs += [fk_spec(n), fk_study_spec(n), jacobian_spec(n), jacobian_dot_spec(n)]
     return [joint_polynomials(), chain_study_polynomials(2)], specs, {"jacobian_check": checks}

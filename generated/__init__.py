@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 67f7a1985ee87d5b
+Content hash: 8536d35009d48de7
 """

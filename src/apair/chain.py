@@ -436,6 +436,10 @@ class AChain:
         """(∂τ/∂θ, ∂τ/∂θ', M), each (..., n, n), [i, k] = ∂τ_i/∂x_k; exact (apair.derivatives)."""
         return D.inverse_dynamics_derivatives(self, q, qd, qdd)
 
+    def jacobian_dot(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
+        """(..., 6, n): dJ/dt of `jacobian` moving at qd (J̇q' is the tool's acceleration bias)."""
+        return D.jacobian_dot(self, q, qd)
+
     def forward_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike) -> D.Triple:
         """(∂θ''/∂θ, ∂θ''/∂θ', M⁻¹ = ∂θ''/∂τ), each (..., n, n), at θ'' = forward_dynamics(q, qd, tau)."""
         return D.forward_dynamics_derivatives(self, q, qd, tau)

@@ -1,7 +1,8 @@
 """Derivatives of a chain's dynamics in its state (AChain.inverse_dynamics_derivatives,
 AChain.forward_dynamics_derivatives), from the generated kernels of
 derivations/chain_dynamics_derivatives.py: forward-mode derivatives of the recursions' steps,
-exact up to rounding (no finite differences).
+exact up to rounding (no finite differences); and the Jacobian's time derivative
+(AChain.jacobian_dot, the kernels jacobian_dot<n> of derivations/chain_kinematics.py).
 
 The kernels take the joints' law values as every chain kernel does, and d'''(θ) per joint from
 each pair's law_<kind>_d3 kernel (the law's third derivative, which only ∂τ/∂θ needs). Inputs are
@@ -30,6 +31,13 @@ class DynamicsChain(Protocol):
     def _law_groups(self) -> list[tuple[str, NDArray[np.intp], list[NDArray[np.float64]]]]: ...
     @property
     def _body(self) -> tuple[NDArray[np.float64], ...]: ...
+    @property
+    def _framed(self) -> bool: ...
+    @property
+    def base(self) -> NDArray[np.float64]: ...
+    @property
+    def tool(self) -> NDArray[np.float64]: ...
+
     def _state(self, q: ArrayLike, strict: bool = ..., **named: ArrayLike) -> list[NDArray[np.float64]]: ...
     def _law(self, q: NDArray[np.float64]) -> NDArray[np.float64]: ...
 
@@ -71,3 +79,26 @@ def forward_dynamics_derivatives(chain: DynamicsChain, q: ArrayLike, qd: ArrayLi
             "links: the mass matrix is not positive definite at this q (give every moving body mass and inertia)"
         )
     return out[0], out[1], out[2]
+
+
+def jacobian_dot(chain: DynamicsChain, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
+    """(..., 6, n): dJ/dt of chain.jacobian(q) moving at qd (world frame, rows [v; ω] of the tool's
+    origin). With a tool offset p, J's rows [v + ω × r; ω] (r = R_n p) change by ω̇ × r + ω × ṙ,
+    ṙ = ω_n × r, ω_n = J_ω q'; the base rotates both blocks."""
+    q_, qd_ = chain._state(q, qd=qd)
+    law = chain._law(q_)
+    if not np.isfinite(law).all():
+        raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
+    body = chain._body
+    out: NDArray[np.float64] = call(f"jacobian_dot{chain.n}", law, qd_, *body[:2])[0]
+    if not chain._framed:
+        return out
+    base, tool = chain.base, chain.tool
+    dJv, dJw = out[..., :3, :], out[..., 3:, :]
+    if tool[:3, 3].any():  # frame n in frame 0 and its Jacobian's ω rows, from the frame-0 kernels
+        r = call(f"fk{chain.n}", law, body[0])[0][..., :3, :3] @ tool[:3, 3]
+        Jw0 = call(f"jacobian{chain.n}", law, *body[:2])[0][..., 3:, :]
+        r_dot = np.cross(np.einsum("...ik,...k->...i", Jw0, qd_), r)
+        dJv = dJv + np.cross(dJw, r[..., :, None], axis=-2) + np.cross(Jw0, r_dot[..., :, None], axis=-2)
+    Rb = base[:3, :3]
+    return np.concatenate([Rb @ dJv, Rb @ dJw], axis=-2)

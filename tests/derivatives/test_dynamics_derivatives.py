@@ -236,3 +236,18 @@ def test_massless_links_are_refused_by_forward_derivatives():
     chain = apair.AChain([apair.APair.revolute()] * 2, [0.3, 0.2], [0.0, 0.0])
     with pytest.raises(ValueError, match="links: the mass matrix is not positive definite"):
         chain.forward_dynamics_derivatives([0.1, 0.2], [0.0, 0.0], [0.0, 0.0])
+
+
+@pytest.mark.parametrize(("name", "n"), CASES)
+def test_jacobian_dot_equals_central_differences_along_the_motion(name, n, backend):
+    """J̇ = dJ/dt at (q, q') against (J(q + h q') − J(q − h q')) / 2h, base and tool frames and
+    every pair kind included; broadcast over a batch of q."""
+    chain, q, qd, _ = design(name, n)
+    h = 1e-6 / max(1.0, float(np.abs(qd).max()))
+    if name == "range_end":  # stay inside the range
+        h = min(h, 1e-3 * float(np.min(np.abs(np.array([p.theta_limit for p in chain.pairs]) - np.abs(q)))))
+    ref = (chain.jacobian(q + h * qd) - chain.jacobian(q - h * qd)) / (2 * h)
+    got = chain.jacobian_dot(q, qd)
+    assert got.shape == (6, n)
+    assert rel(got, ref, floor=1e-3) < 1e-6, (name, n)
+    assert rel(chain.jacobian_dot(np.stack([q, q]), qd)[1], got) < 1e-15
