@@ -155,11 +155,15 @@ def _cmd_limits(args: argparse.Namespace) -> int:
         for i, p in enumerate(chain.pairs)
     ]
     plot = _clearance_plot(args, chain)
+    slides = any(p.kind == "prismatic" for p in chain.pairs)
     if args.json:
-        units = {"limits": "rad (m for a prismatic joint)", "limits_deg": "deg (none for a prismatic joint)"}
+        units = {"limits": "rad", "limits_deg": "deg"}
+        if slides:  # the units of a chain without slides stay as they were
+            units = {"limits": "rad (m for a prismatic joint)", "limits_deg": "deg (none for a prismatic joint)"}
         emit({"chain": chain.name, "units": units, "joints": joints, "plot": plot})
         return 0
-    print(f"{chain.name}: joint ranges [deg; mm for slides] (explicit, or where the legs or plates first touch)")
+    unit = "deg; mm for slides" if slides else "deg"
+    print(f"{chain.name}: joint ranges [{unit}] (explicit, or where the legs or plates first touch)")
     for j, p in zip(joints, chain.pairs):
         lo, hi = np.asarray(j["limits"]) * 1000 if p.kind == "prismatic" else j["limits_deg"]
         print(f"  joint {j['joint']}: {lo:+10.4f} .. {hi:+10.4f}   {j['what']}")
