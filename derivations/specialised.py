@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from . import apair_pair, chain_dynamics, chain_kinematics
+from . import apair_pair, chain_dynamics, chain_dynamics_derivatives, chain_kinematics
 from .spec import Arg, Call, KernelSpec
 
 SOURCE = "derivations/specialised.py"
@@ -40,7 +40,13 @@ KERNELS = {
     "inverse_dynamics": "inverse_dynamics",
     "forward_dynamics": "forward_dynamics",
     "energy": "energy",
+    "inverse_dynamics_derivatives": "inverse_dynamics_derivatives",
+    "forward_dynamics_derivatives": "forward_dynamics_derivatives",
 }
+# The dynamics' derivatives (derivations/chain_dynamics_derivatives.py) are made only when asked
+# for: their derivation takes minutes for six joints, against seconds for all the others.
+DERIVATIVES = ("inverse_dynamics_derivatives", "forward_dynamics_derivatives")
+DEFAULT = tuple(k for k in KERNELS if k not in DERIVATIVES)
 KINEMATIC = ("fk", "fk_study", "jacobian")
 KINDS = ("revolute", "sinusoidal", "general", "helical", "prismatic")
 _LAW_ARITY = {"revolute": 0, "sinusoidal": 1, "general": 2, "helical": 1, "prismatic": 0}
@@ -145,21 +151,30 @@ def joint_values(n: int) -> Arg:
     return Arg("q", (n,), "joint values q_i: angles theta_i [rad], slides d_i [m] of prismatic pairs", syms)
 
 
-def law_steps(design: Design, law_symbols, q: Arg) -> tuple[list, dict]:
+def law_steps(design: Design, law_symbols, q: Arg, dddd_symbols=()) -> tuple[list, dict]:
     """Each joint's law kernel with its constants substituted, its input θ → q_i: the steps and
-    the bindings of the chain kernels' law symbols (ch, sh, d, d', d'' per joint). An R-pair
-    keeps the half angle too: with sincos of θ instead, the bench's 6R fk took 120 ns instead of
-    95 (libm is faster on the smaller half angles than the three operations saved)."""
+    the bindings of the chain kernels' law symbols (ch, sh, d, d', d'' per joint), and of
+    `dddd_symbols` (d''' per joint, the law_<kind>_d3 kernels', whose steps are the law kernel's
+    and are not repeated). An R-pair keeps the half angle too: with sincos of θ instead, the
+    bench's 6R fk took 120 ns instead of 95 (libm is faster on the smaller half angles than the
+    three operations saved)."""
     laws = {s.name: s for s in apair_pair.law_specs()}
+    thirds = {s.name: s for s in apair_pair.law_d3_specs()}
     steps, env = [], {}
     for i, (kind, params) in enumerate(zip(design.kinds, design.law)):
-        spec = laws[f"law_{kind}"]
-        sub = {spec.inputs[0].symbols[0]: q.symbols[i]}
-        sub.update({a.symbols[0]: _number(x) for a, x in zip(spec.inputs[1:], params)})
-        more, sub = _fold(spec.steps, sub, suffix=f"_{i + 1}")
-        steps += more
-        for s, e in zip(law_symbols[5 * i : 5 * i + 5], spec.outputs[0].exprs):
-            env[s] = _floats(sp.S(e).xreplace(sub))
+        sub: dict = {}
+        for spec, symbols, width in (
+            (laws[f"law_{kind}"], law_symbols, 5),
+            (thirds[f"law_{kind}_d3"], dddd_symbols, 1),
+        ):
+            if not len(symbols):
+                continue
+            sub[spec.inputs[0].symbols[0]] = q.symbols[i]
+            sub.update({a.symbols[0]: _number(x) for a, x in zip(spec.inputs[1:], params)})
+            more, sub = _fold([(s, e) for s, e in spec.steps if s not in sub], sub, suffix=f"_{i + 1}")
+            steps += more
+            for s, e in zip(symbols[width * i : width * i + width], spec.outputs[0].exprs):
+                env[s] = _floats(sp.S(e).xreplace(sub))
     return steps, env
 
 
@@ -202,7 +217,8 @@ def specialise(spec: KernelSpec, design: Design, name: str, doc: str, zeros=(), 
         head, steps, env = [law], [], {}
     else:
         head = [q]
-        steps, env = law_steps(design, law.symbols, q)
+        thirds = by_name["dddd"].symbols if "dddd" in by_name and not keep else ()
+        steps, env = law_steps(design, law.symbols, q, thirds)
     env.update(design_values(design, flat.inputs))
     env.update({s: sp.S(0) for z in zeros for s in by_name[z].symbols})
     inputs = head + [a for a in flat.inputs if a.name in STATE and a.name not in zeros]
@@ -217,7 +233,12 @@ def specialise(spec: KernelSpec, design: Design, name: str, doc: str, zeros=(), 
             steps,
         )
         steps = []
-        calls.append(Call(laws, ("q",), tuple(sp.Symbol(f"{s.name}_v", real=True) for s in law.symbols)))
+        results = tuple(sp.Symbol(f"{s.name}_v", real=True) for s in law.symbols)
+        calls.append(Call(laws, ("q",), results))
+        env.update(zip(law.symbols, results))  # the kernel's own steps take the law values of the first part
+        if "dddd" in by_name:  # and d3 of the laws (derivative kernels) in its own steps, from q
+            steps, more = law_steps(design, (), q, by_name["dddd"].symbols)
+            env.update(more)
         for c in flat.calls:
             passed = {a.name: arg for arg, a in zip(c.args, c.kernel.inputs)}
             part_zeros = [a for a, arg in passed.items() if arg is None]
@@ -252,13 +273,16 @@ def generic_specs(n: int, families) -> dict[str, KernelSpec]:
                 "jacobian": chain_kinematics.jacobian_spec(n),
             }
         )
-    if any(f not in out for f in families):
+    if any(f not in out and f not in DERIVATIVES for f in families):
         for s in chain_dynamics.specs_for(n):
+            out[s.name[: -len(str(n))]] = s
+    if any(f in DERIVATIVES for f in families):
+        for s in chain_dynamics_derivatives.specs_for_n(n):
             out[s.name[: -len(str(n))]] = s
     return out
 
 
-def chain_specs(design: Design, kernels=tuple(KERNELS)) -> list[KernelSpec]:
+def chain_specs(design: Design, kernels=DEFAULT) -> list[KernelSpec]:
     """The specialised kernels (public names, in KERNELS order) of the design."""
     unknown = [k for k in kernels if k not in KERNELS]
     if unknown:

@@ -52,6 +52,9 @@ METHODS = (
     ("inverse_dynamics", True),
     ("forward_dynamics", True),
     ("energy", True),
+    ("inverse_dynamics_derivatives", True),  # with mass_matrix (apair.derivatives.KERNELS_OF)
+    ("forward_dynamics_derivatives", True),
+    ("jacobian_dot", True),
 )
 
 
@@ -305,7 +308,7 @@ class AChain:
         generic chain kernel, fed by the pairs' law kernels."""
         return native_chain(
             self.n,
-            [(f"{family}{self.n}", strict) for family, strict in METHODS],
+            [(tuple(f"{k}{self.n}" for k in D.kernels_of(family)), strict) for family, strict in METHODS],
             [p.law_kernel for p in self.pairs],
             [p.theta_limit if p.theta_limit is not None else math.inf for p in self.pairs],
             dict(zip(("dh", "turning", "links", "legs", "gravity"), self._body)),
@@ -434,15 +437,15 @@ class AChain:
 
     def inverse_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> D.Triple:
         """(∂τ/∂θ, ∂τ/∂θ', M), each (..., n, n), [i, k] = ∂τ_i/∂x_k; exact (apair.derivatives)."""
-        return D.inverse_dynamics_derivatives(self, q, qd, qdd)
+        return D.inverse_dynamics_derivatives(self, q, qd, qdd, 10)
 
     def jacobian_dot(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
         """(..., 6, n): dJ/dt of `jacobian` moving at qd (J̇q' is the tool's acceleration bias)."""
-        return D.jacobian_dot(self, q, qd)
+        return D.jacobian_dot(self, q, qd, 12)
 
     def forward_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike) -> D.Triple:
         """(∂θ''/∂θ, ∂θ''/∂θ', M⁻¹ = ∂θ''/∂τ), each (..., n, n), at θ'' = forward_dynamics(q, qd, tau)."""
-        return D.forward_dynamics_derivatives(self, q, qd, tau)
+        return D.forward_dynamics_derivatives(self, q, qd, tau, 11)
 
     def energy(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
         """(..., 2): kinetic and potential energy (T, V) [J], legs included; V of gravity (in the
@@ -457,9 +460,10 @@ class AChain:
     def specialise(self, kernels: Iterable[str] | None = None) -> AChain:
         """This chain with its design built into its own kernels (`apair codegen`'s C, compiled
         once into the cache, see apair.files.cache_root, and found again by content hash):
-        the same methods, faster. `kernels`: a subset of fk, fk_study, jacobian, mass_matrix,
-        coriolis, gravity_torques, bias, inverse_dynamics, forward_dynamics, energy (default: all;
-        the others stay generic). Without a C compiler it warns once and uses the generic kernels
+        the same methods, faster. `kernels`: a subset of fk, fk_study, jacobian, mass_matrix, coriolis,
+        gravity_torques, bias, inverse_dynamics, forward_dynamics, energy (default: these), and
+        inverse_dynamics_derivatives, forward_dynamics_derivatives (minutes to derive: only when named);
+        the others stay generic. Without a C compiler it warns once and uses the generic kernels
         (`.specialised` says which). Base and tool frames are built in (apair.specialise)."""
         from .specialise import check_frames
 
@@ -763,9 +767,9 @@ class AChain:
 
 
 class SpecialisedChain(AChain):
-    """An AChain whose kernel-backed methods (fk ... energy) run the chain's own specialised C
-    kernels (AChain.specialise, built by apair.specialise); everything else is the AChain's. Where
-    they cannot be had (no C compiler), the generic kernels serve, as said once in a warning."""
+    """An AChain whose kernel-backed methods chosen (fk ... energy, the dynamics' derivatives) run the
+    chain's own specialised C kernels (AChain.specialise, built by apair.specialise); everything else
+    is the AChain's. Where they cannot be had (no C compiler), the generic kernels serve (warned once)."""
 
     def __init__(self, chain: AChain, kernels: Iterable[str] | None = None) -> None:
         from .specialise import check_kernels, content_hash

@@ -213,33 +213,38 @@ class _NoFastPath:
 
 def native_chain(
     n: int,
-    methods: Iterable[tuple[str, bool]],
+    methods: Iterable[tuple[str | tuple[str, ...], bool]],
     laws: Iterable[tuple[str, Sequence[float]]],
     limits: Iterable[float],
     design: Mapping[str, NDArray[np.float64]],
     keep: object = None,
     table: tuple[int, Sequence[str]] | None = None,
 ) -> FastPath:
-    """A chain's native fast path (apair._native.Chain): `methods` = [(kernel name, strict)],
-    each a registry kernel, or with `table` = (address, names) an entry of a loaded registry of
-    specialised kernels (AChain.specialise); `laws` = per joint (law kernel name, params), or []
-    when the kernels take q itself; `limits` = per joint |θ| range (inf: none); `design` = the
-    arrays the kernels take by name; `keep`: what must outlive the kernels. Its call(method, q,
-    ...) returns None whenever the caller must validate first (or the backend is NumPy)."""
+    """A chain's native fast path (apair._native.Chain): `methods` = [(kernel name or names,
+    strict)], each a registry kernel or, with `table` = (address, names), an entry of a loaded
+    registry of specialised kernels (AChain.specialise) where it has one; a method of several
+    kernels returns their outputs as one tuple; `laws` = per joint (law kernel name, params), or []
+    when no kernel takes law values (each law's law_<kind>_d3 kernel comes along, for the kernels
+    that take d'''); `limits` = per joint |θ| range (inf: none); `design` = the arrays the kernels
+    take by name; `keep`: what must outlive the kernels. Its call(method, q, ...) returns None
+    whenever the caller must validate first (or the backend is NumPy)."""
     native = _native()[0]
     if native is None:
         return _NoFastPath()
-    if table is None:
-        address = lambda name: native.kernel_address(_c_index(native, name))
-    else:
-        base, names = table
-        index = {name: i for i, name in enumerate(names)}
-        address = lambda name: base + index[name] * native.KERNEL_SIZE if name in index else None
     generic = lambda name: native.kernel_address(_c_index(native, name))
+    index = {} if table is None else {name: i for i, name in enumerate(table[1])}
+    address = lambda name: table[0] + index[name] * native.KERNEL_SIZE if table and name in index else generic(name)
+    names = _c_table(native)
     return native.Chain(
         n,
-        [(address(name), bool(strict)) for name, strict in methods],
-        [(generic(name), tuple(float(x) for x in params)) for name, params in laws],
+        [
+            (tuple(address(k) for k in ((name,) if isinstance(name, str) else name)), bool(strict))
+            for name, strict in methods
+        ],
+        [
+            (generic(name), tuple(float(x) for x in params), generic(f"{name}_d3") if f"{name}_d3" in names else None)
+            for name, params in laws
+        ],
         [float(x) for x in limits],
         dict(design),
         keep,

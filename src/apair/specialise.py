@@ -178,9 +178,12 @@ def prefix_from(path: str | os.PathLike[str]) -> str:
 
 
 def check_kernels(kernels: Iterable[str] | None) -> tuple[str, ...]:
+    """The kernels chosen, in the order of the output, or by default all but the dynamics'
+    derivatives (derivations.specialised.DEFAULT: those take minutes to derive, so are made only
+    when named); a ValueError for an unknown name or none."""
     specialised, _ = _toolkit()
     if kernels is None:
-        return tuple(specialised.KERNELS)
+        return tuple(specialised.DEFAULT)
     chosen = tuple(kernels)
     unknown = [k for k in chosen if k not in specialised.KERNELS]
     if unknown or not chosen:
@@ -218,8 +221,10 @@ def _states(chain: ChainLike, count: int, seed: int) -> dict[str, NDArray[np.flo
 def references(
     chain: ChainLike, kernels: list[Any], count: int = SELFTEST_STATES, seed: int = 0
 ) -> list[dict[str, Any]]:
-    """Inputs and generic-runtime outputs of each kernel on the self-test's states; a kernel whose
-    reference cannot be computed (forward dynamics of a chain without inertia) is left out."""
+    """Inputs and generic-runtime outputs of each kernel on the self-test's states (every output of
+    a kernel of several: the method's first ones, inverse_dynamics_derivatives' M being the
+    mass_matrix kernel's); a kernel whose reference cannot be computed (forward dynamics of a chain
+    without inertia) is left out."""
     states = _states(chain, count, seed)
     methods = {"coriolis": "coriolis_matrix"}
     tests = []
@@ -229,11 +234,12 @@ def references(
             want = getattr(chain, methods.get(k.name, k.name))(*ins)
         except ValueError:
             continue
+        wants = want if isinstance(want, tuple) else (want,)
         tests.append(
             {
                 "name": k.name,
                 "inputs": [(a, [f"{x:.17g}" for x in v.ravel()]) for a, v in zip(k.spec.inputs, ins)],
-                "outputs": [(k.spec.outputs[0], [f"{x:.17g}" for x in np.asarray(want).ravel()])],
+                "outputs": [(a, [f"{x:.17g}" for x in np.asarray(w).ravel()]) for a, w in zip(k.spec.outputs, wants)],
             }
         )
     return tests
@@ -436,10 +442,13 @@ def load(
 ) -> FastPath | None:
     """The native fast path of the chain's specialised kernels (kernels.native_chain) for the
     chain's `methods` ((kernel family, strict) in the order of its fast path: apair.chain.METHODS)
-    and the loaded library, or None (no compiler, or the C backend is not installed)."""
+    and the loaded library, or None (no compiler, or the C backend is not installed). A method
+    whose kernel was not chosen (or has no specialised form: jacobian_dot) gets the generic one,
+    fed by the law kernels, as on the chain's generic fast path."""
     import ctypes
 
     from . import kernels as _kernels
+    from .derivatives import kernels_of
 
     if not _kernels.c_available():
         _warn_once(
@@ -458,12 +467,13 @@ def load(
         raise RuntimeError(f"specialise: {library} holds {count} kernels, expected {len(names)}: remove it")
     base = ctypes.addressof(ctypes.c_char.in_dll(lib, f"{name}_registry"))
     families = {f: k for k, f in _toolkit()[0].KERNELS.items()}
+    kernel = lambda family: families[family] if families.get(family) in names else f"{family}{chain.n}"
     fast = _kernels.native_chain(
         chain.n,
-        [(families.get(family, family), strict) for family, strict in methods],
-        [],
+        [(tuple(kernel(f) for f in kernels_of(family)), strict) for family, strict in methods],
+        [p.law_kernel for p in chain.pairs],
         [p.theta_limit if p.theta_limit is not None else float("inf") for p in chain.pairs],
-        {},
+        dict(zip(("dh", "turning", "links", "legs", "gravity"), chain._body)),
         keep=lib,
         table=(base, names),
     )

@@ -160,7 +160,8 @@ def add_codegen(sub: Sub) -> None:
         "--kernels",
         metavar="LIST",
         help="comma-separated subset of fk, fk_study, jacobian, mass_matrix, coriolis, gravity_torques, "
-        "bias, inverse_dynamics, forward_dynamics, energy (default: all)",
+        "bias, inverse_dynamics, forward_dynamics, energy, inverse_dynamics_derivatives, "
+        "forward_dynamics_derivatives (default: all but the two derivatives, which take minutes to derive)",
     )
     p.add_argument(
         "--force",
