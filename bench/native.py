@@ -5,7 +5,10 @@ file (the states of `count` poses and the chain's design), evaluates every opera
 in round-robin rounds, and prints the minimum ns per evaluation of each operation over the rounds
 as JSON; it also writes its results for the first poses so that agreement is checked before any
 timing is reported (each program first runs one untimed warm-up round). apair's path is the one a C user takes: each joint's law kernel (one sincos
-per joint), then the chain kernel's batch function with the design shared by the batch.
+per joint), then the chain kernel's batch function with the design shared by the batch. The
+derivatives of the dynamics (DERIVATIVES) take each joint's law value and the law's third
+derivative: the law kernel and the law_<kind>_d3 kernel per joint, then the derivative kernel's
+batch function, all three inside the timing.
 """
 
 from __future__ import annotations
@@ -30,6 +33,23 @@ OPERATIONS = {
     "inverse_dynamics": ("inverse_dynamics", ("qd", "qdd"), lambda n: n),
     "forward_dynamics": ("forward_dynamics", ("qd", "tau"), lambda n: n),
 }
+
+# the derivatives of the dynamics: per-pose inputs after the law values and the law's third
+# derivatives, and the kernel's outputs (each n x n, row-major), in the order every program writes
+# them after OPERATIONS' outputs
+DERIVATIVES = {
+    "inverse_dynamics_derivatives": (("qd", "qdd"), ("dtau_dq", "dtau_dqd")),
+    "forward_dynamics_derivatives": (("qd", "tau"), ("dqdd_dq", "dqdd_dqd", "Minv")),
+}
+
+
+def outputs_of(n: int, derivatives: bool) -> list[tuple[str, int]]:
+    """(name, values per pose) of what a program writes, in its order: one output per operation of
+    OPERATIONS, then (if `derivatives`) each output of DERIVATIVES' kernels."""
+    out = [(op, size(n)) for op, (_, _, size) in OPERATIONS.items()]
+    if derivatives:
+        out += [(name, n * n) for _, names in DERIVATIVES.values() for name in names]
+    return out
 
 
 @dataclass
@@ -185,18 +205,21 @@ static void rigid(const double *A, const double *B, double *C) /* C = A B, rigid
     return "\n".join(defs), post, about
 
 
-def apair_program(chain) -> str:
+def apair_program(chain, derivatives: bool = True) -> str:
     """C source timing the generated kernels for `chain` (its pairs' law kernels are fixed here,
     the design is read at run time; the base and tool frames, if any, are applied to fk and the
-    Jacobian as frames_code writes them)."""
+    Jacobian as frames_code writes them). With `derivatives`, also DERIVATIVES' kernels, each timed
+    with the law kernels and the law_<kind>_d3 kernels it needs."""
     n = chain.n
     frame_defs, frame_post, _ = frames_code(chain)
-    law_calls = []
+    law_calls, d3_calls = [], []
     for i, p in enumerate(chain.pairs):
         kernel, params = p.law_kernel
         extra = "".join(f", &LAWP[{i}]" for _ in params)
         law_calls.append(f"apair_{kernel}(&q[{i}]{extra}, &law[{5 * i}]);")
+        d3_calls.append(f"apair_{kernel}_d3(&q[{i}]{extra}, &d3[{i}]);")
     laws = "\n            ".join(law_calls)
+    d3s = "\n            ".join(d3_calls if derivatives else [])
     half = "\n            ".join(f"acc += cos(0.5 * q[{i}]) + sin(0.5 * q[{i}]);" for i in range(n))
     ops_code = []
     for op, (stem, extra, size) in OPERATIONS.items():
@@ -209,21 +232,40 @@ def apair_program(chain) -> str:
             "mass_matrix": ["DH, 0", "TURN, 0", "LINKS, 0", "LEGS, 0"],
         }.get(op, ["DH, 0", "TURN, 0", "LINKS, 0", "LEGS, 0", "GRAV, 0"])
         ops_code.append(
-            (op, f"apair_{stem}{n}_batch((size_t)COUNT, {', '.join(call_inputs + design)}, OUT_{op});", size(n))
+            (
+                op,
+                "laws_all();",
+                f"apair_{stem}{n}_batch((size_t)COUNT, {', '.join(call_inputs + design)}, OUT_{op});",
+                [(op, size(n))],
+            )
         )
+    design_all = "DH, 0, TURN, 0, LINKS, 0, LEGS, 0, GRAV, 0"
+    for op, (extra, outputs) in DERIVATIVES.items() if derivatives else ():
+        state = ", ".join(f"{x.upper()}, {n}" for x in extra)
+        results = ", ".join(f"OUT_{name}" for name in outputs)
+        call = f"apair_{op}{n}_batch((size_t)COUNT, LAW, {5 * n}, D3, {n}, {state}, {design_all}, {results});"
+        ops_code.append((op, "laws_all(); d3_all();", call, [(name, n * n) for name in outputs]))
     body = []
-    for op, call, _size in ops_code:
+    for op, pre, call, _outs in ops_code:
         body.append(f"""
         t0 = now_ns();
-        laws_all();
+        {pre}
         {call}
         {frame_post.get(op, "")}
         t = (now_ns() - t0) / COUNT;
         if (round > 0 && t < best[{len(body)}]) best[{len(body)}] = t;""")
-    names = [op for op, _, _ in ops_code]
-    outs = "\n".join(f"static double *OUT_{op};" for op in names)
-    allocs = "\n    ".join(f"OUT_{op} = (double *)malloc(sizeof(double) * COUNT * {size});" for op, _, size in ops_code)
-    dumps = "\n    ".join(f"fwrite(OUT_{op}, sizeof(double), {CHECKED} * {size}, f);" for op, _, size in ops_code)
+    names = [op for op, _, _, _ in ops_code]
+    d3_timing = d3_print = ""  # the law_<kind>_d3 kernels alone, where the program calls them
+    if derivatives:
+        d3_timing = f"""t0 = now_ns();
+        d3_all();
+        t = (now_ns() - t0) / COUNT;
+        if (round > 0 && t < best[{len(names) + 2}]) best[{len(names) + 2}] = t;"""
+        d3_print = f'printf(", \\"law_d3_kernels\\": %.3f", best[{len(names) + 2}]);'
+    buffers = [buf for _, _, _, bufs in ops_code for buf in bufs]
+    outs = "\n".join(f"static double *OUT_{name};" for name, _ in buffers)
+    allocs = "\n    ".join(f"OUT_{name} = (double *)malloc(sizeof(double) * COUNT * {size});" for name, size in buffers)
+    dumps = "\n    ".join(f"fwrite(OUT_{name}, sizeof(double), {CHECKED} * {size}, f);" for name, size in buffers)
     prints = " ".join(
         f'printf("%s\\"{op}\\": %.3f", "{"{" if k == 0 else ", "}", best[{k}]);' for k, op in enumerate(names)
     )
@@ -236,7 +278,7 @@ def apair_program(chain) -> str:
 #include "apair.h"
 #include "bench_inputs.h"
 
-static double *LAW;
+static double *LAW, *D3;
 {outs}
 {frame_defs}
 
@@ -247,6 +289,16 @@ static void laws_all(void)
         const double *q = Q + k * {n};
         double *law = LAW + k * {5 * n};
         {laws}
+    }}
+}}
+
+static void d3_all(void)
+{{
+    long k;
+    for (k = 0; k < COUNT; ++k) {{
+        const double *q = Q + k * {n};
+        double *d3 = D3 + k * {n};
+        {d3s}
     }}
 }}
 
@@ -263,14 +315,15 @@ static double trig_only(void)
 
 int main(int argc, char **argv)
 {{
-    double best[{len(names) + 2}], t0, t, sink = 0;
+    double best[{len(names) + 3}], t0, t, sink = 0;
     int round, k;
     FILE *f;
     if (argc < 4 || read_inputs(argv[1])) return 2;
     LAW = (double *)malloc(sizeof(double) * COUNT * {5 * n});
+    D3 = (double *)malloc(sizeof(double) * COUNT * {n});
     SCRATCH = (double *)malloc(sizeof(double) * COUNT * 16);
     {allocs}
-    for (k = 0; k < {len(names) + 2}; ++k) best[k] = 1e300;
+    for (k = 0; k < {len(names) + 3}; ++k) best[k] = 1e300;
     for (round = 0; round <= atoi(argv[3]); ++round) {{{"".join(body)}
         t0 = now_ns();
         sink += trig_only();
@@ -280,12 +333,15 @@ int main(int argc, char **argv)
         laws_all();
         t = (now_ns() - t0) / COUNT;
         if (round > 0 && t < best[{len(names) + 1}]) best[{len(names) + 1}] = t;
+        {d3_timing}
     }}
     f = fopen(argv[2], "wb");
     {dumps}
     fclose(f);
     {prints}
-    printf(", \\"trig_floor\\": %.3f, \\"law_kernels\\": %.3f, \\"sink\\": %.3g}}\\n", best[{len(names)}], best[{len(names) + 1}], sink);
+    printf(", \\"trig_floor\\": %.3f, \\"law_kernels\\": %.3f", best[{len(names)}], best[{len(names) + 1}]);
+    {d3_print}
+    printf(", \\"sink\\": %.3g}}\\n", sink);
     return 0;
 }}
 """
@@ -394,25 +450,49 @@ def run_program(exe: Path, inputs: Path, outputs: Path, rounds: int, extra: tupl
     return json.loads(res.stdout)
 
 
-def apair_build(chain, workdir: Path, opt: str) -> Path:
-    """The apair timing program for `chain`, linked with the generated sources it calls."""
+OBJECTS = ROOT / "build" / "bench" / "objects"  # the generated kernels compiled, shared by every chain
+
+
+def kernel_object(source: Path, opt: str) -> Path:
+    """The object file of a generated kernel's C at `opt` (the same gcc flags as compile_c),
+    compiled once per content and flags: the derivative kernels take a minute each at -O3."""
+    import hashlib
+
+    c_dir = source.parent
+    text = "\0".join([source.read_text(), (c_dir / "apair.h").read_text(), opt])
+    OBJECTS.mkdir(parents=True, exist_ok=True)
+    obj = OBJECTS / f"{source.stem}{opt}_{hashlib.sha256(text.encode()).hexdigest()[:16]}.o"
+    if not obj.exists():
+        part = obj.with_suffix(".o.part")
+        subprocess.run(
+            ["gcc", "-std=c99", opt, "-DNDEBUG", f"-I{c_dir}", "-c", str(source), "-o", str(part)], check=True
+        )
+        part.replace(obj)
+    return obj
+
+
+def apair_build(chain, workdir: Path, opt: str, derivatives: bool = True) -> Path:
+    """The apair timing program for `chain`, linked with the generated kernels it calls (each
+    compiled once, kernel_object)."""
     c_dir = ROOT / "generated" / "c"
     n = chain.n
-    kernels = [f"{stem}{n}" for stem, _, _ in OPERATIONS.values()]
-    kernels += sorted({p.law_kernel[0] for p in chain.pairs})
-    exe = workdir / f"apair{n}_{'_'.join(sorted({p.law_kernel[0][4:] for p in chain.pairs}))}{opt}"
-    compile_c(
-        apair_program(chain), exe, [opt, f"-I{c_dir}", f"-I{PEERS}"], [str(c_dir / f"{k}.c") for k in kernels] + ["-lm"]
-    )
+    kinds = sorted({p.law_kernel[0] for p in chain.pairs})
+    kernels = [f"{stem}{n}" for stem, _, _ in OPERATIONS.values()] + kinds
+    if derivatives:
+        kernels += [f"{op}{n}" for op in DERIVATIVES] + [f"{k}_d3" for k in kinds]
+    exe = workdir / f"apair{n}_{'_'.join(k[4:] for k in kinds)}{'_d' if derivatives else ''}{opt}"
+    objects = [str(kernel_object(c_dir / f"{k}.c", opt)) for k in kernels]
+    compile_c(apair_program(chain, derivatives), exe, [opt, f"-I{c_dir}", f"-I{PEERS}"], objects + ["-lm"])
     return exe
 
 
-def read_outputs(path: Path, n: int) -> dict:
+def read_outputs(path: Path, n: int, derivatives: bool) -> dict:
+    """A program's results for the first CHECKED poses: {output name: (CHECKED, size)}."""
     data = np.fromfile(path, dtype=np.float64)
     out, pos = {}, 0
-    for op, (_, _, size) in OPERATIONS.items():
-        k = CHECKED * size(n)
-        out[op] = data[pos : pos + k].reshape(CHECKED, -1)
+    for name, size in outputs_of(n, derivatives):
+        k = CHECKED * size
+        out[name] = data[pos : pos + k].reshape(CHECKED, -1)
         pos += k
     return out
 
@@ -512,40 +592,52 @@ def casadi_generate(workdir: Path, inputs: Path) -> Path:
     return out
 
 
-def casadi_program(n: int, prefix: str) -> str:
-    """C source timing CasADi's generated functions `{prefix}<op>` over the poses, one call per pose."""
+WORK_INT, WORK_REAL = 1 << 14, 1 << 20  # the work arrays given to CasADi's functions (checked)
+
+
+def casadi_program(n: int, prefix: str, derivatives: bool = True) -> str:
+    """C source timing CasADi's generated functions `{prefix}<op>` over the poses, one call per pose
+    (with `derivatives`, also DERIVATIVES': CasADi's jacobians of its rnea and aba)."""
     design = prefix == "pind_"
+    dynamics = ["DH", "LINKS", "GRAV"]
     specs = {
-        "fk": ("Q", [], ["DH"]),
-        "jacobian": ("Q", [], ["DH"]),
-        "mass_matrix": ("Q", [], ["DH", "LINKS"]),
-        "inverse_dynamics": ("Q", ["QD", "QDD"], ["DH", "LINKS", "GRAV"]),
-        "forward_dynamics": ("Q", ["QD", "TAU"], ["DH", "LINKS", "GRAV"]),
+        "fk": ("Q", [], ["DH"], [("fk", OPERATIONS["fk"][2](n))]),
+        "jacobian": ("Q", [], ["DH"], [("jacobian", OPERATIONS["jacobian"][2](n))]),
+        "mass_matrix": ("Q", [], ["DH", "LINKS"], [("mass_matrix", n * n)]),
+        "inverse_dynamics": ("Q", ["QD", "QDD"], dynamics, [("inverse_dynamics", n)]),
+        "forward_dynamics": ("Q", ["QD", "TAU"], dynamics, [("forward_dynamics", n)]),
     }
+    for op, (state, names) in DERIVATIVES.items() if derivatives else ():
+        specs[op] = ("Q", [x.upper() for x in state], dynamics, [(name, n * n) for name in names])
     blocks, outs, allocs, dumps = [], [], [], []
-    for k, (op, (q, state, des)) in enumerate(specs.items()):
-        size = OPERATIONS[op][2](n)
+    for k, (op, (q, state, des, results)) in enumerate(specs.items()):
         fn = f"{prefix}{op}"
         args = [f"{q} + i * {n}"] + [f"{s} + i * {n}" for s in state] + (des if design else [])
-        outs.append(f"static double *OUT_{op};")
-        allocs.append(f"OUT_{op} = (double *)malloc(sizeof(double) * COUNT * {size});")
-        dumps.append(f"fwrite(OUT_{op}, sizeof(double), {CHECKED} * {size}, f);")
+        for name, size in results:
+            outs.append(f"static double *OUT_{name};")
+            allocs.append(f"OUT_{name} = (double *)malloc(sizeof(double) * COUNT * {size});")
+            dumps.append(f"fwrite(OUT_{name}, sizeof(double), {CHECKED} * {size}, f);")
         sets = "\n                ".join(f"arg[{j}] = {a};" for j, a in enumerate(args))
+        sets += "".join(
+            f"\n                res[{j}] = OUT_{name} + i * {size};" for j, (name, size) in enumerate(results)
+        )
+        # every output a dense column (a sparse one would be written compressed)
+        dense = " ".join(
+            f"if (!dense_column({fn}_sparsity_out({j}), {size})) return 4;" for j, (_, size) in enumerate(results)
+        )
         blocks.append(f"""
         {{
             casadi_int sz_arg, sz_res, sz_iw, sz_w;
             const casadi_real *arg[16];
             casadi_real *res[4];
-            static casadi_int iw[4096];
-            static casadi_real w[65536];
             long i;
             {fn}_work(&sz_arg, &sz_res, &sz_iw, &sz_w);
-            if (sz_iw > 4096 || sz_w > 65536) return 3;
+            if (sz_arg > 16 || sz_res > 4 || sz_iw > {WORK_INT} || sz_w > {WORK_REAL}) return 3;
+            {dense}
             t0 = now_ns();
             for (i = 0; i < COUNT; ++i) {{
                 {sets}
-                res[0] = OUT_{op} + i * {size};
-                {fn}(arg, res, iw, w, 0);
+                {fn}(arg, res, IW, W, 0);
             }}
             t = (now_ns() - t0) / COUNT;
             if (round > 0 && t < best[{k}]) best[{k}] = t;
@@ -563,14 +655,23 @@ def casadi_program(n: int, prefix: str) -> str:
 #include "bench_inputs.h"
 
 {chr(10).join(outs)}
+static casadi_int IW[{WORK_INT}];
+static casadi_real W[{WORK_REAL}];
+
+/* CasADi's sparsity of an output: nrow, ncol, then 1 if dense, else the CCS colind[ncol + 1], row */
+static int dense_column(const casadi_int *sp, casadi_int size)
+{{
+    return sp[0] == size && sp[1] == 1 && (sp[2] == 1 || sp[3] == size);
+}}
 
 int main(int argc, char **argv)
 {{
-    double best[5] = {{1e300, 1e300, 1e300, 1e300, 1e300}}, t0, t;
-    int round;
+    double best[{len(specs)}], t0, t;
+    int round, k;
     FILE *f;
     if (argc < 4 || read_inputs(argv[1])) return 2;
     {chr(10).join("    " + a for a in allocs).strip()}
+    for (k = 0; k < {len(specs)}; ++k) best[k] = 1e300;
     for (round = 0; round <= atoi(argv[3]); ++round) {{{"".join(blocks)}
     }}
     f = fopen(argv[2], "wb");
@@ -583,12 +684,17 @@ int main(int argc, char **argv)
 """
 
 
-def casadi_build(workdir: Path, c_dir: Path, n: int, design: bool, opt: str) -> Path:
+def casadi_build(workdir: Path, c_dir: Path, n: int, design: bool, opt: str, derivatives: bool = True) -> Path:
+    """The timing program of CasADi's C code (design baked or as inputs), rebuilt when it changed."""
     prefix = "pind_" if design else "pin_"
-    exe = workdir / f"casadi_{'design' if design else 'baked'}{n}{opt}"
+    exe = workdir / f"casadi_{'design' if design else 'baked'}{n}{'_d' if derivatives else ''}{opt}"
     source = c_dir / f"pin_{'design' if design else 'baked'}.c"
-    compile_c(casadi_program(n, prefix), exe, [opt, f"-I{c_dir}", f"-I{PEERS}"], [str(source), "-lm"])
-    return exe
+    program = casadi_program(n, prefix, derivatives)
+    return cached(
+        exe,
+        [program, opt, source.read_text(), (PEERS / "bench_inputs.h").read_text()],
+        lambda: compile_c(program, exe, [opt, f"-I{c_dir}", f"-I{PEERS}"], [str(source), "-lm"]),
+    )
 
 
 # ------------------------------------------------------------------------------------ the comparison
@@ -596,7 +702,9 @@ AGREE = 5e-12  # largest relative difference (to the largest |value|) accepted b
 
 
 def _agreement(ref: dict, got: dict) -> dict:
-    return {op: float(np.max(np.abs(got[op] - ref[op])) / max(np.max(np.abs(ref[op])), 1.0)) for op in ref}
+    """{output: largest |got - ref| over the checked poses / max(largest |ref|, 1)}, for the outputs
+    both programs wrote."""
+    return {op: float(np.max(np.abs(got[op] - ref[op])) / max(np.max(np.abs(ref[op])), 1.0)) for op in ref if op in got}
 
 
 def compare(
@@ -610,6 +718,7 @@ def compare(
     pin_model=None,
     pin_frame: str = "end",
     specialised: bool = True,
+    derivatives: bool = True,
 ) -> dict:
     """Every tool on `chain` and `states` at each optimisation level: agreement with apair first,
     then `rounds` round-robin rounds (each program evaluates every operation over all poses once
@@ -617,7 +726,11 @@ def compare(
     ("apair") and, if `specialised`, the chain's own specialised code ("apair_specialised").
     `peers`: "pinocchio" (its C++ on `pin_model`, a pinocchio.Model of the same chain whose joints
     are in chain order, timing the frame `pin_frame`: the tool's, as apair's fk and Jacobian give
-    it), "casadi" (its C code of Pinocchio's algorithms on the DH chain of the input file)."""
+    it), "casadi" (its C code of Pinocchio's algorithms on the DH chain of the input file).
+    With `derivatives`, also the derivatives of the dynamics (DERIVATIVES): apair's kernels,
+    Pinocchio's computeRNEADerivatives and computeABADerivatives, CasADi's jacobians of its rnea
+    and aba (the specialised code has none); their outputs are in "difference" by name (dtau_dq,
+    ..., Minv)."""
     unknown = set(peers) - {"pinocchio", "casadi"}
     if unknown:
         raise ValueError(f"peers: unknown {sorted(unknown)}; known: pinocchio, casadi")
@@ -643,7 +756,7 @@ def compare(
             result["skipped"]["casadi"] = str(exc)
     for opt in opts:
         log(f"  building at {opt} ...")
-        tools[f"apair {opt}"] = apair_build(chain, workdir, opt)
+        tools[f"apair {opt}"] = apair_build(chain, workdir, opt, derivatives)
         if specialised:
             tools[f"apair_specialised {opt}"] = specialised_build(chain, workdir, opt)
         if "pinocchio" in peers:
@@ -653,12 +766,13 @@ def compare(
             except (RuntimeError, subprocess.CalledProcessError) as exc:
                 result["skipped"]["pinocchio"] = str(exc)
         if casadi_c is not None:
-            tools[f"casadi_baked {opt}"] = casadi_build(workdir, casadi_c, n, False, opt)
-            tools[f"casadi_design {opt}"] = casadi_build(workdir, casadi_c, n, True, opt)
+            tools[f"casadi_baked {opt}"] = casadi_build(workdir, casadi_c, n, False, opt, derivatives)
+            tools[f"casadi_design {opt}"] = casadi_build(workdir, casadi_c, n, True, opt, derivatives)
     outputs = {}
     for name, exe in tools.items():
         run_program(exe, inputs, workdir / "out.bin", 1, extra.get(name, ()))
-        outputs[name] = read_outputs(workdir / "out.bin", n)
+        with_derivatives = derivatives and not name.startswith("apair_specialised")
+        outputs[name] = read_outputs(workdir / "out.bin", n, with_derivatives)
     ref = outputs[f"apair {opts[0]}"]
     best: dict[str, dict] = {name: {} for name in tools}
     for _r in range(rounds):

@@ -6,8 +6,10 @@ random states, apair's generated C (each joint's law kernel, then the chain kern
 Pinocchio's C++ compiled from its headers and CasADi's C code generated from Pinocchio's
 algorithms on casadi::SX (design baked in, and design as inputs), same gcc flags (-std=c99 or
 c++17, -O2 and -O3, -DNDEBUG, no fast-math, no -march), one pinned core, agreement checked first,
-minimum over round-robin rounds; then the A-chain case (sinusoidal pairs with leg mass), where
-no peer can follow. Before it (alone: --panda-only) the Panda of example-robot-data imported by
+minimum over round-robin rounds; the derivatives of the inverse and forward dynamics too (apair's
+kernels with the law kernels they need, Pinocchio's computeRNEADerivatives and
+computeABADerivatives, CasADi's C code of the jacobians of its rnea and aba); then the A-chain case
+(sinusoidal pairs with leg mass), where no peer can follow. Before it (alone: --panda-only) the Panda of example-robot-data imported by
 apair.load_urdf (7 joints, base and tool frames) against Pinocchio's C++ on the model it builds from
 the same URDF (the fingers locked), and `apair import urdf` of it in a fresh process. Then, from
 Python:
@@ -28,7 +30,8 @@ the operation count of each generated kernel after CSE, growth with n and with t
 the time of a whole `make generate`, and inverse kinematics of 4A-chains. And `AChain.ik_local`
 one pose and one seed per call, as a controller calls it (alone: --ik-local-only): single calls and
 first calls on new chains, against Pinocchio's damped least-squares CLIK loop of its
-examples/inverse-kinematics.py on the R-twin chain, same poses and seeds. Results go to
+examples/inverse-kinematics.py on the R-twin chain, same poses and seeds. And the derivatives of
+the dynamics one state per call (alone: --derivatives-only) against Pinocchio's binding. Results go to
 bench/results.json (or --out). Nothing here is asserted: the targets are reported as met or missed.
 """
 
@@ -278,6 +281,100 @@ def bench_chain(n: int, rng, batch: int, single: int, slow: int, repeats: int, p
     return out
 
 
+DERIVATIVE_CALLS = {  # the chain's method: Pinocchio's binding, and the state's third argument
+    "inverse_dynamics_derivatives": ("computeRNEADerivatives", "qdd"),
+    "forward_dynamics_derivatives": ("computeABADerivatives", "tau"),
+}
+
+
+def _symmetric_upper(A: np.ndarray) -> np.ndarray:
+    """A's upper triangle mirrored (Pinocchio fills only that part of M and Minv)."""
+    return np.triu(A) + np.triu(A, 1).T
+
+
+def derivatives_single(quick: bool, pin_ok: bool) -> dict:
+    """chain.inverse_dynamics_derivatives and chain.forward_dynamics_derivatives, one state per call
+    from Python, on a 6-joint R-chain (random_chain's), against Pinocchio's Python binding
+    (pin.computeRNEADerivatives, pin.computeABADerivatives, bound to the model and its data) on
+    pin_model of the same chain and the same states; per call as bench_chain times the other
+    single calls (a loop of calls, median over repeats). All three results of each call are
+    compared first (Pinocchio's M and Minv symmetrised), largest |difference| relative to the
+    largest value over the first states."""
+    from functools import partial
+
+    rng = np.random.default_rng(39)  # its own: the other sections' draws stay as they were
+    single, repeats, checked = (200, 3, 10) if quick else (2000, 7, 50)
+    n = 6
+    chain = random_chain(n, rng)
+    state = {
+        "q": rng.uniform(-np.pi, np.pi, (single, n)),
+        "qd": rng.normal(size=(single, n)),
+        "qdd": rng.normal(size=(single, n)),
+        "tau": rng.normal(size=(single, n)),
+    }
+    out: dict = {"n": n, "calls": single}
+    model = pin_model(chain) if pin_ok else None
+    for op, (pin_name, third) in DERIVATIVE_CALLS.items():
+        args = [(state["q"][k], state["qd"][k], state[third][k]) for k in range(single)]
+        method = getattr(chain, op)
+        row: dict = {"c_single_api": per_item(loop(method, args), single, repeats)}
+        if model is not None:
+            import pinocchio as pin
+
+            peer = partial(getattr(pin, pin_name), model, model.createData())
+            worst = 0.0
+            for a in args[:checked]:
+                mine = method(*a)
+                theirs = [np.array(x) for x in peer(*a)]
+                theirs[2] = _symmetric_upper(theirs[2])  # M (dtau_da) or Minv
+                for x, y in zip(mine, theirs):
+                    worst = max(worst, float(np.abs(x - y).max() / max(np.abs(x).max(), 1.0)))
+            row["pinocchio_per_call"] = per_item(loop(peer, args), single, repeats)
+            row["max_relative_difference"] = worst
+            row["apair_over_pinocchio"] = row["c_single_api"]["median_ns"] / row["pinocchio_per_call"]["median_ns"]
+        out[op] = row
+    return out
+
+
+def derivatives_single_targets(r: dict) -> list[dict]:
+    """Issue 39's: the Python single calls <= 1.0 x Pinocchio's binding, and the same results."""
+    out = []
+    for op, (pin_name, _) in DERIVATIVE_CALLS.items():
+        row = r.get(op, {})
+        if "apair_over_pinocchio" not in row:
+            continue
+        ratio = row["apair_over_pinocchio"]
+        out.append(
+            {
+                "target": f"Python single call, chain.{op}, n = 6: <= 1.0 x pin.{pin_name}",
+                "measured": ratio,
+                "met": ratio <= 1.0,
+            }
+        )
+        out.append(
+            {
+                "target": f"chain.{op} agrees with pin.{pin_name} to {DERIVATIVE_AGREE:g} relative",
+                "measured": row["max_relative_difference"],
+                "met": row["max_relative_difference"] <= DERIVATIVE_AGREE,
+            }
+        )
+    return out
+
+
+def print_derivatives_single(r: dict) -> None:
+    print(f"\nderivatives of the dynamics from Python, n = {r['n']} R-chain, one state per call ({r['calls']} calls):")
+    for op, (pin_name, _) in DERIVATIVE_CALLS.items():
+        row = r[op]
+        line = f"  chain.{op:30s}median {fmt(row['c_single_api']['median_ns'])}"
+        if "pinocchio_per_call" in row:
+            line += (
+                f"; pin.{pin_name} {fmt(row['pinocchio_per_call']['median_ns'])} "
+                f"(apair / pin {row['apair_over_pinocchio']:.2f}); largest difference "
+                f"{row['max_relative_difference']:.1e} relative"
+            )
+        print(line)
+
+
 def batch_scaling(n: int, rng, repeats: int) -> dict:
     """ns per item of the C kernels against the batch size (one call per batch)."""
     chain = random_chain(n, rng)
@@ -365,7 +462,7 @@ def random_achain(n: int, rng) -> apair.AChain:
 
 def native_section(rng, quick: bool) -> dict:
     """The compiled comparison (bench/native.py) for n = 6: the R-chain with every peer, and an
-    A-chain with apair alone."""
+    A-chain with apair alone, both with the derivatives of the dynamics; and examples/4a_chain.toml."""
     from bench import native
 
     count, rounds = (2000, 3) if quick else (10_000, 7)
@@ -395,9 +492,12 @@ def native_section(rng, quick: bool) -> dict:
             peers=peers,
             log=lambda m: print(m, file=sys.stderr, flush=True),
             pin_model=pin_model(chain) if peers else None,
+            derivatives=label != "examples/4a_chain.toml",  # the two n = 6 chains
         )
     manifest = kernels.manifest()["kernels"]
-    out["apair_ops_per_item"] = {op: manifest[f"{op}6"]["ops_per_item"] for op in native.OPERATIONS}
+    out["apair_ops_per_item"] = {
+        op: manifest[f"{op}6"]["ops_per_item"] for op in (*native.OPERATIONS, *native.DERIVATIVES)
+    }
     return out
 
 
@@ -492,6 +592,7 @@ def panda_section(rng, quick: bool) -> dict:
         pin_model=panda_pin_model(path) if pin_ok else None,
         pin_frame=PANDA_TIP,
         specialised=False,
+        derivatives=False,
     )
     out["urdf"] = str(path)
     out["tip"] = PANDA_TIP
@@ -587,6 +688,42 @@ def native_targets(native_res: dict) -> list[dict]:
                 out.append(
                     {"target": f"{op} {opt}: apair <= 1.3 x its sincos calls alone", "measured": r, "met": r <= 1.3}
                 )
+    return out + derivative_targets(tools)
+
+
+DERIVATIVE_PEERS = {  # Pinocchio's algorithm of each derivative operation, and the outputs compared
+    "inverse_dynamics_derivatives": ("computeRNEADerivatives", ("dtau_dq", "dtau_dqd")),
+    "forward_dynamics_derivatives": ("computeABADerivatives", ("dqdd_dq", "dqdd_dqd", "Minv")),
+}
+DERIVATIVE_AGREE = 1e-9  # relative: a larger difference means the tools compute different things
+
+
+def derivative_targets(tools: dict) -> list[dict]:
+    """Issue 39's, per opt level on the n = 6 R-chain: apair's derivatives of the inverse and
+    forward dynamics <= 0.5 x Pinocchio's computeRNEADerivatives / computeABADerivatives and
+    <= 0.7 x CasADi's C code of the jacobians of its rnea / aba (design as inputs, as apair's
+    kernels take it); and every peer's derivatives agree with apair's to DERIVATIVE_AGREE."""
+    out = []
+    for opt in ("-O2", "-O3"):
+        me = tools.get(f"apair {opt}")
+        if me is None or "inverse_dynamics_derivatives" not in me["ns"]:
+            continue
+        for op, (pin_name, names) in DERIVATIVE_PEERS.items():
+            for peer, bound, what in (("pinocchio", 0.5, pin_name), ("casadi_design", 0.7, "CasADi's jacobian C")):
+                other = tools.get(f"{peer} {opt}")
+                if other is None or op not in other["ns"]:
+                    continue
+                r = me["ns"][op] / other["ns"][op]
+                out.append({"target": f"{op} {opt}: apair <= {bound} x {what}", "measured": r, "met": r <= bound})
+                worst = max(other["difference"][name] for name in names)
+                out.append(
+                    {
+                        "target": f"{op} {opt}: {peer} agrees with apair ({', '.join(names)}) to "
+                        f"{DERIVATIVE_AGREE:g} relative",
+                        "measured": worst,
+                        "met": worst <= DERIVATIVE_AGREE,
+                    }
+                )
     return out
 
 
@@ -595,23 +732,37 @@ def print_native(native_res: dict) -> None:
     names = list(r["tools"])
     print("\ncompiled, n = 6 R-chain, ns per evaluation (min over rounds); ratio = apair / peer at the same -O:")
     print(f"{'':18s}" + "".join(f"{n:>17s}" for n in names))
-    for op in ("fk", "jacobian", "mass_matrix", "inverse_dynamics", "forward_dynamics"):
+    short = {"inverse_dynamics_derivatives": "d inverse_dyn", "forward_dynamics_derivatives": "d forward_dyn"}
+    for op in OPS + tuple(DERIVATIVE_PEERS):
         cells = []
         for name in names:
-            t = r["tools"][name]["ns"][op]
-            opt = name.split()[-1]
-            mine = r["tools"][f"apair {opt}"]["ns"][op]
+            t = r["tools"][name]["ns"].get(op)
+            mine = r["tools"][f"apair {name.split()[-1]}"]["ns"].get(op)
+            if t is None or mine is None:
+                cells.append("-")
+                continue
             cells.append(f"{t:8.0f}" + (f" ({mine / t:.2f})" if not name.startswith("apair") else "       "))
-        print(f"{op:18s}" + "".join(f"{c:>17s}" for c in cells))
+        print(f"{short.get(op, op):18s}" + "".join(f"{c:>17s}" for c in cells))
     for opt in ("-O2", "-O3"):
         me = r["tools"].get(f"apair {opt}")
         if me:
+            d3 = me["ns"].get("law_d3_kernels")
             print(
                 f"apair {opt}: sincos of the 6 half angles alone {me['ns']['trig_floor']:.0f} ns, "
                 f"the 6 law kernels {me['ns']['law_kernels']:.0f} ns"
+                + ("" if d3 is None else f", the 6 law_<kind>_d3 kernels {d3:.0f} ns (both in the derivatives' times)")
             )
-    worst = max(v for t in r["tools"].values() for v in t["difference"].values())
+    derived = {name for _, names in DERIVATIVE_PEERS.values() for name in names}
+    worst = max(v for t in r["tools"].values() for k, v in t["difference"].items() if k not in derived)
     print(f"largest difference from apair (relative to the largest value): {worst:.1e}")
+    for op, (_, outputs) in DERIVATIVE_PEERS.items():
+        diffs = [
+            f"{name} " + ", ".join(f"{k} {t['difference'][k]:.1e}" for k in outputs)
+            for name, t in r["tools"].items()
+            if not name.startswith("apair") and all(k in t["difference"] for k in outputs)
+        ]
+        if diffs:
+            print(f"{op}, largest difference from apair (relative): " + "; ".join(diffs))
     print(
         "operations per evaluation: apair " + ", ".join(f"{k} {v}" for k, v in native_res["apair_ops_per_item"].items())
     )
@@ -1097,6 +1248,11 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--panda-only", action="store_true", help="only the imported Panda against Pinocchio's C++, and its import time"
     )
+    ap.add_argument(
+        "--derivatives-only",
+        action="store_true",
+        help="only the derivatives of the dynamics from Python, one state per call, against Pinocchio's binding",
+    )
     ap.add_argument("--out", type=Path, default=ROOT / "bench" / "results.json")
     args = ap.parse_args(argv)
     try:
@@ -1138,6 +1294,16 @@ def main(argv=None) -> int:
         args.out.write_text(json.dumps(results, indent=1, default=_plain) + "\n")
         print(f"written to {args.out}")
         return 0
+    if args.derivatives_only:
+        results["derivatives_single"] = derivatives_single(args.quick, pin_ok)
+        results["derivatives_single_targets"] = derivatives_single_targets(results["derivatives_single"])
+        print_derivatives_single(results["derivatives_single"])
+        print("\ntargets (derivatives from Python):")
+        for t in results["derivatives_single_targets"]:
+            print(f"  [{'met' if t['met'] else 'MISSED'}] {t['target']}: {t['measured']:.3g}")
+        args.out.write_text(json.dumps(results, indent=1, default=_plain) + "\n")
+        print(f"written to {args.out}")
+        return 0
     results["panda"] = panda_section(np.random.default_rng(38), args.quick)  # its own draws
     results["panda_targets"] = panda_targets(results["panda"])
     print_panda(results["panda"])
@@ -1161,6 +1327,7 @@ def main(argv=None) -> int:
     for n in (2, 4, 6):
         print(f"n = {n}: deriving the expressions for lambdify/symengine and timing ...", file=sys.stderr, flush=True)
         results["kernels"][str(n)] = bench_chain(n, rng, batch, single, slow, repeats, pin_ok, se_ok)
+    results["derivatives_single"] = derivatives_single(args.quick, pin_ok)
     results["batch_scaling"] = batch_scaling(6, rng, repeats)
     cases = {
         "4A random generic designs": (
@@ -1180,7 +1347,10 @@ def main(argv=None) -> int:
     results["codegen_6_s"] = time_codegen(random_achain(6, rng))
     results["design"] = time_design(quick=args.quick)
     results["targets"] = (
-        targets(results) + ik_local_targets(results["ik_local_single"]) + design_targets(results["design"])
+        targets(results)
+        + derivatives_single_targets(results["derivatives_single"])
+        + ik_local_targets(results["ik_local_single"])
+        + design_targets(results["design"])
     )
 
     print("\nper evaluation, median over repeats (ratio = peer time / batched C time):")
@@ -1233,6 +1403,7 @@ def main(argv=None) -> int:
     r = results["ik_local"]
     print(f"  ik_local n = 6: {r['us_per_converged']:.2f} µs per converged solve ({r['converged']:.1%} converged)")
     print_ik_local_single(results["ik_local_single"])
+    print_derivatives_single(results["derivatives_single"])
     if results["make_generate_s"] is not None:
         print(f"\nmake generate (derivations + code generation): {results['make_generate_s']:.1f} s")
     worst = max(

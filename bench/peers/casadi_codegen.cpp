@@ -3,8 +3,12 @@
 //   pin_<op>:  the design's constants baked in (inputs: the state only);
 //   pind_<op>: the design as inputs, as apair's kernels take it (dh (4n), links (10n), gravity (3)).
 // Operations: fk (T, row-major 4x4), jacobian (6 x n, LOCAL_WORLD_ALIGNED, row-major), mass_matrix
-// (n x n, both triangles), inverse_dynamics (rnea), forward_dynamics (aba). Outputs are column
-// vectors in row-major order. Usage: casadi_codegen INPUT OUTPUT_DIR
+// (n x n, both triangles), inverse_dynamics (rnea), forward_dynamics (aba), and the derivatives
+// of the dynamics by CasADi's own differentiation of those SX graphs (ADScalar::jacobian):
+// inverse_dynamics_derivatives (two outputs: d rnea / dq, d rnea / dv) and
+// forward_dynamics_derivatives (three: d aba / dq, d aba / dv, d aba / dtau = Minv, the last as
+// apair's kernel and Pinocchio's computeABADerivatives give it too). Outputs are column vectors in
+// row-major order. Usage: casadi_codegen INPUT OUTPUT_DIR
 #include <pinocchio/autodiff/casadi.hpp>
 
 #include <pinocchio/algorithm/aba.hpp>
@@ -88,6 +92,17 @@ static ADScalar column(const std::vector<ADScalar> &entries)
     return ADScalar::vertcat(entries);
 }
 
+// the entries of the SX matrix A as a dense column, row by row (a jacobian's structural zeros
+// written as zeros: a sparse output would be written compressed)
+static ADScalar row_major(const ADScalar &A)
+{
+    const ADScalar D = ADScalar::densify(A);
+    std::vector<ADScalar> entries;
+    for (casadi_int r = 0; r < D.size1(); ++r)
+        for (casadi_int c = 0; c < D.size2(); ++c) entries.push_back(D(r, c));
+    return ADScalar::densify(column(entries));
+}
+
 static void add_functions(::casadi::CodeGenerator &gen, ADModel &model, const std::string &prefix,
                           const std::vector<ADScalar> &design)
 {
@@ -137,12 +152,19 @@ static void add_functions(::casadi::CodeGenerator &gen, ADModel &model, const st
         out.clear();
         for (int r = 0; r < N; ++r) out.push_back(data.tau[r]);
         add(gen, ::casadi::Function(prefix + "inverse_dynamics", inputs({q, v, a}, all), {column(out)}));
+        const ADScalar tau = column(out);
+        add(gen, ::casadi::Function(prefix + "inverse_dynamics_derivatives", inputs({q, v, a}, all),
+                                    {row_major(ADScalar::jacobian(tau, q)), row_major(ADScalar::jacobian(tau, v))}));
     }
     {
         aba(model, data, qe, ve, ae);  // a is the torque here
         out.clear();
         for (int r = 0; r < N; ++r) out.push_back(data.ddq[r]);
         add(gen, ::casadi::Function(prefix + "forward_dynamics", inputs({q, v, a}, all), {column(out)}));
+        const ADScalar ddq = column(out);
+        add(gen, ::casadi::Function(prefix + "forward_dynamics_derivatives", inputs({q, v, a}, all),
+                                    {row_major(ADScalar::jacobian(ddq, q)), row_major(ADScalar::jacobian(ddq, v)),
+                                     row_major(ADScalar::jacobian(ddq, a))}));
     }
 }
 

@@ -1,5 +1,9 @@
 // Pinocchio's C++ algorithms (double) on the model and states of bench/native.py's input files:
 // the same round-robin timing as apair's program, the same output layout for the agreement check.
+// After fk, the frame Jacobian, crba, rnea and aba, the derivatives of the dynamics:
+// computeRNEADerivatives (dtau_dq, dtau_dv; it also fills M = dtau_da, not written) and
+// computeABADerivatives (ddq_dq, ddq_dv, Minv, whose upper triangle only Pinocchio fills: it is
+// written symmetrised), each written as n x n row-major blocks.
 //   pinocchio_timing INPUT OUTPUT ROUNDS MODEL
 // MODEL (bench/native.py's write_pin_model, from a pinocchio.Model built in Python: the DH chain's
 // or a URDF's) holds the kinematic tree as doubles: the joint count, then per joint its type (0, 1,
@@ -8,11 +12,13 @@
 // mass, 3 x 3 inertia about it, in the joint's frame); then the timed frame (parent joint,
 // placement) and the gravity. The model is rebuilt here with addJoint and appendBodyToJoint, so the
 // algorithms see the model Pinocchio's own builders (DH or URDF) make.
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/jacobian.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/multibody.hpp>
 
@@ -28,6 +34,14 @@ static SE3 placement_of(const double *p)
     Eigen::Matrix3d R;
     R << p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8];
     return SE3(R, Eigen::Vector3d(p[9], p[10], p[11]));
+}
+
+// the n x n matrix A (its upper triangle only if `upper`, mirrored) row-major at out
+static void write_square(const Eigen::MatrixXd &A, bool upper, double *out)
+{
+    const int n = (int)A.rows();
+    for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c) out[n * r + c] = upper && r > c ? A(c, r) : A(r, c);
 }
 
 static bool read_model(const char *path, Model &model, FrameIndex &fid)
@@ -72,8 +86,10 @@ int main(int argc, char **argv)
     const long checked = COUNT < 16 ? COUNT : 16;
     std::vector<double> outT(16 * checked), outJ(6 * n * checked), outM(n * n * checked), outTau(n * checked),
         outQdd(n * checked);
+    const long sq = n * n * checked;
+    std::vector<double> outDtauDq(sq), outDtauDv(sq), outDdqDq(sq), outDdqDv(sq), outMinv(sq);
     Data::Matrix6x J(6, n);
-    double best[5] = {1e300, 1e300, 1e300, 1e300, 1e300};
+    double best[7] = {1e300, 1e300, 1e300, 1e300, 1e300, 1e300, 1e300};
     double sink = 0;
     using Vec = Eigen::Map<const Eigen::VectorXd>;
     for (int round = 0; round <= rounds; ++round) {  // round 0: warm-up
@@ -125,6 +141,29 @@ int main(int argc, char **argv)
         }
         t = (now_ns() - t0) / COUNT;
         if (round > 0 && t < best[4]) best[4] = t;
+        t0 = now_ns();
+        for (long k = 0; k < COUNT; ++k) {
+            computeRNEADerivatives(model, data, Vec(&Q[k * n], n), Vec(&QD[k * n], n), Vec(&QDD[k * n], n));
+            if (k < checked) {
+                write_square(data.dtau_dq, false, &outDtauDq[n * n * k]);
+                write_square(data.dtau_dv, false, &outDtauDv[n * n * k]);
+            }
+            sink += data.dtau_dq(0, 0);
+        }
+        t = (now_ns() - t0) / COUNT;
+        if (round > 0 && t < best[5]) best[5] = t;
+        t0 = now_ns();
+        for (long k = 0; k < COUNT; ++k) {
+            computeABADerivatives(model, data, Vec(&Q[k * n], n), Vec(&QD[k * n], n), Vec(&TAU[k * n], n));
+            if (k < checked) {
+                write_square(data.ddq_dq, false, &outDdqDq[n * n * k]);
+                write_square(data.ddq_dv, false, &outDdqDv[n * n * k]);
+                write_square(data.Minv, true, &outMinv[n * n * k]);
+            }
+            sink += data.ddq_dq(0, 0);
+        }
+        t = (now_ns() - t0) / COUNT;
+        if (round > 0 && t < best[6]) best[6] = t;
     }
     FILE *f = std::fopen(argv[2], "wb");
     std::fwrite(outT.data(), sizeof(double), outT.size(), f);
@@ -132,9 +171,12 @@ int main(int argc, char **argv)
     std::fwrite(outM.data(), sizeof(double), outM.size(), f);
     std::fwrite(outTau.data(), sizeof(double), outTau.size(), f);
     std::fwrite(outQdd.data(), sizeof(double), outQdd.size(), f);
+    for (const std::vector<double> *out : {&outDtauDq, &outDtauDv, &outDdqDq, &outDdqDv, &outMinv})
+        std::fwrite(out->data(), sizeof(double), out->size(), f);
     std::fclose(f);
     std::printf("{\"fk\": %.3f, \"jacobian\": %.3f, \"mass_matrix\": %.3f, \"inverse_dynamics\": %.3f, "
-                "\"forward_dynamics\": %.3f, \"sink\": %.3g}\n",
-                best[0], best[1], best[2], best[3], best[4], sink);
+                "\"forward_dynamics\": %.3f, \"inverse_dynamics_derivatives\": %.3f, "
+                "\"forward_dynamics_derivatives\": %.3f, \"sink\": %.3g}\n",
+                best[0], best[1], best[2], best[3], best[4], best[5], best[6], sink);
     return 0;
 }

@@ -25,7 +25,10 @@ OP_NAMES = {
     "mass_matrix": "mass matrix",
     "inverse_dynamics": "inverse dynamics",
     "forward_dynamics": "forward dynamics",
+    "inverse_dynamics_derivatives": "∂ inverse dynamics (∂τ/∂q, ∂τ/∂q′)",
+    "forward_dynamics_derivatives": "∂ forward dynamics (∂q″/∂q, ∂q″/∂q′, M⁻¹)",
 }
+DERIVATIVE_OPS = ("inverse_dynamics_derivatives", "forward_dynamics_derivatives")  # where a run measured them
 PEERS = {
     "apair": "apair",
     "apair_specialised": "apair, specialised",
@@ -113,7 +116,7 @@ def compiled(r: dict) -> str:
         me = tools[f"apair {opt}"]["ns"]
         peers = [p for p in ("pinocchio", "casadi_design", "casadi_baked") if f"{p} {opt}" in tools]
         rows = []
-        for op in OPS:
+        for op in OPS + tuple(d for d in DERIVATIVE_OPS if d in me):
             cells = [OP_NAMES[op], f"{me[op]:.0f}"]
             for p in peers:
                 t = tools[f"{p} {opt}"]["ns"].get(op)
@@ -207,6 +210,14 @@ def python_single(r: dict) -> str:
             cells.append("–" if t is None else f"{t:.0f}" + (f" ({t / pin:.2f})" if pin else ""))
         cells.append("–" if pin is None else f"{pin:.0f}")
         rows.append(cells)
+    derivatives = r.get("derivatives_single", {})
+    for op, peer in zip(DERIVATIVE_OPS, ("computeRNEADerivatives", "computeABADerivatives")):
+        row = derivatives.get(op)
+        if row is None:
+            continue
+        t, pin = row["c_single_api"]["median_ns"], row.get("pinocchio_per_call", {}).get("median_ns")
+        cells = [f"`{op}` / `{peer}`", f"{t:.0f}" + (f" ({t / pin:.2f})" if pin else ""), "–"]
+        rows.append(cells + ["–" if pin is None else f"{pin:.0f}"])
     return table(
         ["n = 6, ns (ratio to Pinocchio)", "generic chain", "specialised chain", "Pinocchio's Python binding"], rows
     )

@@ -204,6 +204,21 @@ def test_benchmark_tables_come_from_the_results_file():
     }
     text = h.render(page, partial)
     assert "This results file has no" in text and not h.MARKER.search(text)
+    # a run with the derivatives of the dynamics: their rows, with the numbers of the file
+    tools = {
+        name: {"ns": {**t["ns"], "inverse_dynamics_derivatives": 1234.0 + k, "forward_dynamics_derivatives": 4321.0}}
+        for k, (name, t) in enumerate(results["native"]["R-chain"]["tools"].items())
+        if not name.startswith("apair_specialised")
+    }
+    single = {"c_single_api": {"median_ns": 5678.0}, "pinocchio_per_call": {"median_ns": 2839.0}}
+    with_derivatives = dict(
+        results,
+        native=dict(results["native"], **{"R-chain": dict(results["native"]["R-chain"], tools=tools)}),
+        derivatives_single={"inverse_dynamics_derivatives": single, "forward_dynamics_derivatives": single},
+    )
+    text = h.render(page, with_derivatives)
+    assert h.OP_NAMES["inverse_dynamics_derivatives"] in text and "| 4321 (" in text
+    assert "`forward_dynamics_derivatives` / `computeABADerivatives` | 5678 (2.00)" in text
     with pytest.raises(ValueError, match="unknown benchmark section"):
         h.render("<!-- bench:no-such-table -->", results)
 
