@@ -8,6 +8,8 @@ joint values and complex poses, with their derivatives:
   give (cos(θ/2), sin(θ/2), d, d') at a complex z, from the pair's law d(θ) (`apair_pair.LAWS`)
   with θ = −2i log z substituted: Laurent polynomials, no trigonometric call. (An A-pair's pose
   changes with θ + 2π, an R-pair's does not: the tracker identifies R-pair angles modulo 2π.)
+  A P-pair's variable is its slide x itself (its angle held at 0, φ_i its fixed angle): its law
+  values are (1, 0, x, 1), with the turning factor w = 0 (below), and F is linear in x.
 - The target. A pose is (t, q): translation t ∈ C³ and rotation quaternion q ∈ C⁴ up to scale,
   both entering linearly, so that a straight line between two poses is a homotopy of poses and the
   solution set over all (t, q) is irreducible (monodromy can reach every solution).
@@ -18,7 +20,8 @@ joint values and complex poses, with their derivatives:
   agree: no other solutions (a random combination of the twelve equations q ⊗ e_k = (R e_k) ⊗ q
   would add a whole component of spurious ones).
 - Derivatives. ∂F/∂θ_i = [v_i ; G ω_i] with [v_i; ω_i] the screw Jacobian's column i
-  (`chain_kinematics.screw_jacobian`, pitch d'_i included) and G_c = ½ vec(q̄ ⊗ e_c ⊗ x), since
+  (`chain_kinematics.screw_jacobian`, pitch d'_i and the turning factor w_i included: 1 for an
+  angle, 0 for a P-pair's slide, whose column is [z_{i−1}; 0]) and G_c = ½ vec(q̄ ⊗ e_c ⊗ x), since
   ∂x/∂θ_i = ½ (0, ω_i) ⊗ x. Fs = [−dt ; vec(dq̄ ⊗ x)] is the derivative along a direction (dt, dq).
 
 Complex values are carried as (real, imaginary) pairs: every step is split into its real and
@@ -35,7 +38,7 @@ import mpmath
 import sympy as sp
 
 from .apair_pair import LAWS, h, theta
-from .chain_kinematics import _Recorder, dh_study_half, frames, joint_symbols, screw_jacobian
+from .chain_kinematics import _Recorder, dh_study_half, frames, joint_symbols, screw_jacobian, turning_arg
 from .quaternions import Quaternion
 from .spec import Arg, KernelSpec
 
@@ -239,7 +242,7 @@ def system_spec(n: int) -> KernelSpec:
     )
     rec = _Recorder()
     F = frames(n, J, rec)
-    Jm = screw_jacobian(F, J, turning=False)
+    Jm = screw_jacobian(F, J)
     T = F[n]
     x = _rotation(J, rec)
     q, dq = tsyms[3:], dsyms[3:]
@@ -270,7 +273,7 @@ def system_spec(n: int) -> KernelSpec:
             "the derivative of F along a direction (dt, dq) of poses."
         ),
         source=SOURCE,
-        inputs=[law_arg, tgt_arg, dir_arg, dh_arg],
+        inputs=[law_arg, tgt_arg, dir_arg, dh_arg, turning_arg(J)],
         steps=steps,
         outputs=[
             _complex_out("F", (6,), "residual", outs[:nF]),
@@ -282,7 +285,8 @@ def system_spec(n: int) -> KernelSpec:
 
 def residual_spec(n: int) -> KernelSpec:
     """ik_residual{n}: F of ik_system{n} alone, from z_i = exp(iθ_i/2) and the amplitudes h_i
-    (the sinusoidal law; h = 0 is an R-pair's), also emitted in extended precision (`wide`).
+    (the sinusoidal law; h = 0 is an R-pair's) and the slides x_i added to d_i (a P-pair: z_i = 1,
+    h_i = 0, x_i its variable), also emitted in extended precision (`wide`).
 
     Far out in the complex (|Im θ| ≈ 10) the terms of F that cancel are exp(2|Im θ|) larger than
     F: in double precision Newton's method stalls at about 1e-5. The tracker's corrector takes F
@@ -294,6 +298,13 @@ def residual_spec(n: int) -> KernelSpec:
         "an R-pair's law is the sinusoidal law with h = 0"
     )
     v_arg, parts, vsyms = _complex_arg("v", (n,), "per joint exp(i theta_i/2)", [f"v_{i}" for i in range(1, n + 1)])
+    slide_arg, sparts, ssyms = _complex_arg(
+        "slide",
+        (n,),
+        "per joint a slide added to d_i [m] (a P-pair's variable, its v = 1; 0 otherwise)",
+        [f"x_{i}" for i in range(1, n + 1)],
+    )
+    parts.update(sparts)
     hs = tuple(sp.Symbol(f"h_{i}", real=True) for i in range(1, n + 1))
     h_arg = Arg("h", (n,), "per joint the amplitude h_i of a sinusoidal A-pair, 0 for an R-pair [m]", hs, design=True)
     tgt_arg, tparts, tsyms = _complex_arg(
@@ -309,7 +320,7 @@ def residual_spec(n: int) -> KernelSpec:
         j = joint_symbols(i)
         sub = {zs: vsyms[i - 1], h: hs[i - 1]}
         for f, e in zip(("ch", "sh", "d"), law_s):
-            j[f] = rec.name(f"L{i}_{f}", sp.expand(e.xreplace(sub)))
+            j[f] = rec.name(f"L{i}_{f}", sp.expand(e.xreplace(sub) + (ssyms[i - 1] if f == "d" else 0)))
         J.append(j)
     dh_arg = Arg(
         "dh",
@@ -323,11 +334,11 @@ def residual_spec(n: int) -> KernelSpec:
     return KernelSpec(
         name=f"ik_residual{n}",
         doc=(
-            f"The residual F of ik_system{n} at z_i = exp(i theta_i/2) (the laws included), also in extended "
-            "precision for the tracker's corrector far out in the complex."
+            f"The residual F of ik_system{n} at z_i = exp(i theta_i/2) (the laws included) and the P-pairs' "
+            "slides, also in extended precision for the tracker's corrector far out in the complex."
         ),
         source=SOURCE,
-        inputs=[v_arg, h_arg, tgt_arg, dh_arg],
+        inputs=[v_arg, slide_arg, h_arg, tgt_arg, dh_arg],
         steps=steps,
         outputs=[_complex_out("F", (6,), "residual", outs)],
         wide=True,
@@ -372,12 +383,13 @@ def _mp_quaternion(R):
     return [(R[1, 0] - R[0, 1]) / s, (R[0, 2] + R[2, 0]) / s, (R[1, 2] + R[2, 1]) / s, s / 4]
 
 
-def _mp_system(angles, hs, dh, target, x_sign=None):
-    """F by the 4×4 DH product (d = h cos(θ/2)) and the quaternion of its rotation in mpmath;
-    x_sign: a quaternion whose sign the result's is aligned with (q and −q are one rotation)."""
+def _mp_system(joints, dh, target, x_sign=None):
+    """F by the 4×4 DH product and the quaternion of its rotation in mpmath; joints: per joint
+    (θ_i, d_i) (an A-pair's d = h cos(θ/2), a P-pair's θ = 0 and d = x); x_sign: a quaternion whose
+    sign the result's is aligned with (q and −q are one rotation)."""
     T = mpmath.eye(4)
-    for th, hh, row in zip(angles, hs, dh):
-        T = T * _mp_dh(th, hh * mpmath.cos(th / 2), *row)
+    for (th, d), row in zip(joints, dh):
+        T = T * _mp_dh(th, d, *row)
     x = _mp_quaternion(T)
     if x_sign is not None:
         dot = sum(a * b for a, b in zip(x, x_sign))
@@ -388,6 +400,15 @@ def _mp_system(angles, hs, dh, target, x_sign=None):
     return [T[k, 3] - target[k] for k in range(3)] + vec, x
 
 
+def _mp_joints(values, kinds, hs):
+    """(θ_i, d_i) per joint from its variable: an angle (A- or R-pair, d = h cos(θ/2)) or a P-pair's
+    slide x (θ = 0, d = x)."""
+    return [(0, v) if k == "P" else (v, hh * mpmath.cos(v / 2)) for v, k, hh in zip(values, kinds, hs)]
+
+
+KINDS = "APR"  # the joints of the checks, in turn: A-, P-, R-pair, ...
+
+
 def _evaluate(spec: KernelSpec, values: dict, dh, digits: int):
     """A complex-valued kernel spec at mpmath inputs (values: {input name: complex values, or for
     the real input h real values}, dh rows): its outputs as complex numbers, and the quaternion x
@@ -396,7 +417,7 @@ def _evaluate(spec: KernelSpec, values: dict, dh, digits: int):
     for a in spec.inputs:
         if a.name == "dh":
             env.update({s: sp.Float(x, digits) for s, x in zip(a.symbols, [x for row in dh for x in row])})
-        elif a.name == "h":
+        elif a.name in ("h", "turning"):
             env.update({s: sp.Float(mpmath.re(x), digits) for s, x in zip(a.symbols, values[a.name])})
         else:
             for k, z in enumerate(values[a.name]):
@@ -405,7 +426,7 @@ def _evaluate(spec: KernelSpec, values: dict, dh, digits: int):
     for s, e in spec.steps:
         env[s] = sp.N(e.xreplace(env), digits)
     flat = [mpmath.mpmathify(sp.N(e.xreplace(env), digits)) for a in spec.outputs for e in a.exprs]
-    n = spec.inputs[-1].shape[0]
+    n = next(a for a in spec.inputs if a.name == "dh").shape[0]
     # the kernel's quaternion sign: the half-angle product's (the matrix route's is aligned with it)
     x = [
         mpmath.mpmathify(sp.N(sp.Symbol(f"X{n}_{k}_re", real=True).xreplace(env), digits))
@@ -417,12 +438,13 @@ def _evaluate(spec: KernelSpec, values: dict, dh, digits: int):
 
 def check_residual(n: int = 3, digits: int = 30) -> float:
     """Max difference between ik_residual{n} and the independent route (the 4×4 DH product) at
-    a random complex point with the joints alternately A- and R-pairs."""
+    a random complex point with the joints A-, P- and R-pairs in turn (KINDS)."""
     spec = residual_spec(n)
     rng = random.Random(200 + n)
+    kinds = [KINDS[i % 3] for i in range(n)]
     with mpmath.workdps(digits):
         th = [mpmath.mpc(rng.uniform(-3, 3), rng.uniform(-2, 2)) for _ in range(n)]
-        hs = [rng.uniform(0.2, 1.0) if i % 2 == 0 else 0.0 for i in range(n)]
+        hs = [rng.uniform(0.2, 1.0) if k == "A" else 0.0 for k in kinds]
         dh = [
             [
                 mpmath.mpf(rng.uniform(-1, 1)),
@@ -433,10 +455,10 @@ def check_residual(n: int = 3, digits: int = 30) -> float:
             for _ in range(n)
         ]
         target = [mpmath.mpc(rng.uniform(-1, 1), rng.uniform(-1, 1)) for _ in range(7)]
-        got, x_kernel = _evaluate(
-            spec, {"v": [mpmath.exp(1j * t / 2) for t in th], "h": hs, "target": target}, dh, digits
-        )
-        F, _ = _mp_system(th, hs, dh, target, x_kernel)
+        v = [1 if k == "P" else mpmath.exp(1j * t / 2) for t, k in zip(th, kinds)]
+        slide = [t if k == "P" else 0 for t, k in zip(th, kinds)]
+        got, x_kernel = _evaluate(spec, {"v": v, "slide": slide, "h": hs, "target": target}, dh, digits)
+        F, _ = _mp_system(_mp_joints(th, kinds, hs), dh, target, x_kernel)
         worst = max(abs(g - f) for g, f in zip(got, F))
     assert worst < 1e-15, f"ik_residual{n} differs from the DH route by {worst}"
     return float(worst)
@@ -445,16 +467,17 @@ def check_residual(n: int = 3, digits: int = 30) -> float:
 def check_system(n: int = 3, digits: int = 30) -> float:
     """Max difference between the kernel's expressions and the independent route at a random
     complex point: F, dF/dθ (central differences of the DH product) and dFs (F is linear in the
-    pose, so F(p + dp) − F(p))."""
+    pose, so F(p + dp) − F(p)), with the joints A-, P- and R-pairs in turn (KINDS)."""
     spec = system_spec(n)
     rng = random.Random(100 + n)
+    kinds = [KINDS[i % 3] for i in range(n)]
 
     def cplx():
         return mpmath.mpc(rng.uniform(-1, 1), rng.uniform(-1, 1))
 
     with mpmath.workdps(digits):
         th = [cplx() for _ in range(n)]
-        hs = [rng.uniform(0.2, 1.0) if i % 2 == 0 else 0.0 for i in range(n)]  # A-, R-, A-pair, ...
+        hs = [rng.uniform(0.2, 1.0) if k == "A" else 0.0 for k in kinds]
         dh = [
             [
                 mpmath.mpf(rng.uniform(-1, 1)),
@@ -467,11 +490,21 @@ def check_system(n: int = 3, digits: int = 30) -> float:
         target, direction = [cplx() for _ in range(7)], [cplx() for _ in range(7)]
         law = [
             x
-            for t, hh in zip(th, hs)
-            for x in (mpmath.cos(t / 2), mpmath.sin(t / 2), hh * mpmath.cos(t / 2), -hh / 2 * mpmath.sin(t / 2))
+            for t, hh, k in zip(th, hs, kinds)
+            for x in (
+                (1, 0, t, 1)
+                if k == "P"
+                else (mpmath.cos(t / 2), mpmath.sin(t / 2), hh * mpmath.cos(t / 2), -hh / 2 * mpmath.sin(t / 2))
+            )
         ]
-        got, x_kernel = _evaluate(spec, {"law": law, "target": target, "direction": direction}, dh, digits)
-        F, x = _mp_system(th, hs, dh, target, x_kernel)
+        turning = [0 if k == "P" else 1 for k in kinds]
+        values = {"law": law, "target": target, "direction": direction, "turning": turning}
+        got, x_kernel = _evaluate(spec, values, dh, digits)
+
+        def system(values, target, x_sign):
+            return _mp_system(_mp_joints(values, kinds, hs), dh, target, x_sign)
+
+        F, x = system(th, target, x_kernel)
         worst = max(abs(a - b) for a, b in zip(x, x_kernel))
         worst = max([worst] + [abs(g - f) for g, f in zip(got[:6], F)])
         eps = mpmath.mpf(10) ** -10
@@ -479,10 +512,10 @@ def check_system(n: int = 3, digits: int = 30) -> float:
             up, dn = list(th), list(th)
             up[i] += eps
             dn[i] -= eps
-            Fu, Fd = _mp_system(up, hs, dh, target, x)[0], _mp_system(dn, hs, dh, target, x)[0]
+            Fu, Fd = system(up, target, x)[0], system(dn, target, x)[0]
             worst = max([worst] + [abs(got[6 + r * n + i] - (Fu[r] - Fd[r]) / (2 * eps)) for r in range(6)])
         shifted = [a + b for a, b in zip(target, direction)]
-        Fs = [a - b for a, b in zip(_mp_system(th, hs, dh, shifted, x)[0], F)]
+        Fs = [a - b for a, b in zip(system(th, shifted, x)[0], F)]
         worst = max([worst] + [abs(g - f) for g, f in zip(got[6 + 6 * n :], Fs)])
     assert worst < 1e-15, f"ik_system{n} differs from the DH route by {worst}"
     return float(worst)

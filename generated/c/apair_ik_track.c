@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_track.c (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_track.c. Content hash: 807ad9cf4a965326
+ * generated/c. Do not edit: edit src/csrc/apair_ik_track.c. Content hash: 486939b727993f75
  */
 /*
  * Path tracking of the homotopy system ik_system6 (all solutions of a pose, driven by
@@ -22,6 +22,8 @@
 #define ENDGAME_RATIO 0.8 /* the most a path to infinity's slope may shrink from one sample to the next */
 #define ENDGAME_SLOPE 0.1 /* the least outward slope of the farthest angle (per unit of log(1 - tau)) */
 #define LN2 0.6931471805599453
+#define KIND_A 1 /* the problem's joint kinds (apair_ik_problem): 0 an R-pair, 1 a sinusoidal A-pair, */
+#define KIND_P 4 /* 4 a P-pair, whose variable is its slide x (law (1, 0, x, 1), turning factor 0) */
 
 /* Solves A X = B for complex A and B (see GAUSS_SOLVE). */
 GAUSS_SOLVE(csolve_m, cplx, cabs)
@@ -44,7 +46,8 @@ typedef struct {
     const apair_kernel *sys, *law[2];
     double inv[INV_MAX];
     double inv_res[INV_RES];          /* ik_residual6's invariants, for residual_wide */
-    double h[NMAX];                   /* the amplitudes (0 for an R-pair), ik_residual6's input */
+    double h[NMAX];                   /* the amplitudes (0 for an R- or P-pair), ik_residual6's input */
+    double turning[NMAX];             /* ik_system6's turning factors: 0 for a P-pair, else 1 */
     cplx p0[7], dp[7], gamma;
     int nv;                            /* variables: the n angles, or n + 1 with a slice */
     const apair_ik_slice *slice; /* NULL: H = F(theta; p(s)); else the slice system */
@@ -68,21 +71,24 @@ static cplx pose_at(const tracker *tr, const cplx *v, cplx s, int k)
 }
 
 /* The slice's joint j at s: z = exp(i k theta_j) (k = 1/2 for an A-pair, 1 for an R-pair) and the
- * coefficients a, b of z and 1/z in l_s. Returns k. */
+ * coefficients a, b of z and 1/z in l_s; for a P-pair z = x and b the coefficient of 1 (k = 0).
+ * Returns k. */
 static double slice_term(const tracker *tr, const cplx *v, cplx s, int j, cplx *z, cplx *a, cplx *b)
 {
     const apair_ik_slice *sl = tr->slice;
     int n = tr->pb->n;
-    double k = tr->pb->kind[j] ? 0.5 : 1.0;
-    *z = cexp(I * k * v[j]);
+    int slide = tr->pb->kind[j] == KIND_P;
+    double k = slide ? 0.0 : tr->pb->kind[j] == KIND_A ? 0.5 : 1.0;
+    *z = slide ? v[j] : cexp(I * k * v[j]);
     *a = pair_at(sl->ell, j) + s * pair_at(sl->dell, j);
     *b = pair_at(sl->ell, n + j) + s * pair_at(sl->dell, n + j);
     return k;
 }
 
 /* H(theta, tau) = F(theta; p(s)) with p(s) = p0 + s (p1 - p0), s = gamma tau / (1 + (gamma - 1) tau);
- * Hv = dH/dtheta (n x n), Ht = dH/dtau; the law kernels take exp(i theta / 2). With a slice, the
- * slice system in (theta, lambda) (nv x nv). Returns -1 if a value is not finite. */
+ * Hv = dH/dtheta (n x n), Ht = dH/dtau; the law kernels take exp(i theta / 2), a P-pair's law is
+ * (1, 0, x, 1) at its slide x = theta_i. With a slice, the slice system in (theta, lambda)
+ * (nv x nv). Returns -1 if a value is not finite. */
 static int eval(const tracker *tr, const cplx *v, double tau, cplx *H, cplx *Hv, cplx *Ht)
 {
     const apair_ik_problem *pb = tr->pb;
@@ -90,11 +96,16 @@ static int eval(const tracker *tr, const cplx *v, double tau, cplx *H, cplx *Hv,
     int n = pb->n;
     double law[NMAX * 8];
     for (int i = 0; i < n; i++) {
+        if (pb->kind[i] == KIND_P) {
+            double out[8] = {1.0, 0.0, 0.0, 0.0, creal(v[i]), cimag(v[i]), 1.0, 0.0};
+            memcpy(law + 8 * i, out, 8 * sizeof(double));
+            continue;
+        }
         cplx z = cexp(0.5 * I * v[i]);
         double vin[2] = {creal(z), cimag(z)}, out[8];
         const double *in[2] = {vin, pb->pair + 2 * i};
         double *outs[1] = {out};
-        tr->law[pb->kind[i] != 0]->eval(in, outs);
+        tr->law[pb->kind[i] == KIND_A]->eval(in, outs);
         memcpy(law + 8 * i, out, 8 * sizeof(double));
     }
     cplx ds, s = path_s(tr, tau, &ds);
@@ -108,7 +119,7 @@ static int eval(const tracker *tr, const cplx *v, double tau, cplx *H, cplx *Hv,
         dir[2 * k + 1] = cimag(d);
     }
     double F[12], dF[6 * NMAX * 2], dFs[12];
-    const double *in[4] = {law, target, dir, pb->dh};
+    const double *in[5] = {law, target, dir, pb->dh, tr->turning};
     double *out[3] = {F, dF, dFs};
     if (tr->sys->n_invariants)
         tr->sys->core(tr->inv, in, out);
@@ -131,10 +142,10 @@ static int eval(const tracker *tr, const cplx *v, double tau, cplx *H, cplx *Hv,
         for (int j = 0; j < n; j++) {
             cplx z, a, b;
             double k = slice_term(tr, v, s, j, &z, &a, &b);
-            cplx zi = 1.0 / z;
+            cplx zi = k ? 1.0 / z : 1.0; /* a P-pair's term is a x + b */
             l += a * z + b * zi;
             dl += pair_at(sl->dell, j) * z + pair_at(sl->dell, n + j) * zi;
-            Hv[n * nv + j] = I * k * (a * z - b * zi) * mu;
+            Hv[n * nv + j] = k ? I * k * (a * z - b * zi) * mu : a * mu;
         }
         H[n] = (l - 1.0) * mu + pair_at(sl->t0, 0) + s * pair_at(sl->dt, 0);
         Hv[n * nv + n] = sl->times_lambda ? l - 1.0 : 0.0;
@@ -146,7 +157,7 @@ static int eval(const tracker *tr, const cplx *v, double tau, cplx *H, cplx *Hv,
 }
 
 /* H of eval with the residual in extended precision (apair_wide): F from ik_residual6_wide at
- * z = exp(i theta / 2), and the slice's equation summed in apair_wide. Far out in the complex the
+ * z = exp(i theta / 2) (a P-pair: z = 1 and its slide), and the slice's equation summed in apair_wide. Far out in the complex the
  * terms of H that cancel are exp(2 |Im theta|) larger than H; in double, Newton stalls there. The
  * values z, the pose and the slice's coefficients are the double ones (H is exact at them). */
 static int residual_wide(const tracker *tr, const cplx *v, double tau, cplx *H)
@@ -154,11 +165,14 @@ static int residual_wide(const tracker *tr, const cplx *v, double tau, cplx *H)
     const apair_ik_problem *pb = tr->pb;
     const apair_ik_slice *sl = tr->slice;
     int n = pb->n;
-    apair_wide z[2 * NMAX], target[14], F[12];
+    apair_wide z[2 * NMAX], slide[2 * NMAX], target[14], F[12];
     for (int i = 0; i < n; i++) {
-        cplx e = cexp(0.5 * I * v[i]);
+        int p = pb->kind[i] == KIND_P;
+        cplx e = p ? 1.0 : cexp(0.5 * I * v[i]), x = p ? v[i] : 0.0;
         z[2 * i] = creal(e);
         z[2 * i + 1] = cimag(e);
+        slide[2 * i] = creal(x);
+        slide[2 * i + 1] = cimag(x);
     }
     cplx s = path_s(tr, tau, NULL);
     for (int k = 0; k < 7; k++) {
@@ -166,17 +180,17 @@ static int residual_wide(const tracker *tr, const cplx *v, double tau, cplx *H)
         target[2 * k] = creal(t);
         target[2 * k + 1] = cimag(t);
     }
-    apair_internal_ik_residual6_wide(tr->inv_res, z, tr->h, target, pb->dh, F);
+    apair_internal_ik_residual6_wide(tr->inv_res, z, slide, tr->h, target, pb->dh, F);
     for (int r = 0; r < 6; r++) H[r] = (double)F[2 * r] + I * (double)F[2 * r + 1];
     if (sl) { /* (l_s - 1) mu + t0 + s dt, l_s = sum a_j z_j + b_j / z_j */
         apair_wide lr = -1.0, li = 0.0;
         for (int j = 0; j < n; j++) {
             cplx e, a, b;
-            slice_term(tr, v, s, j, &e, &a, &b);
+            double k = slice_term(tr, v, s, j, &e, &a, &b);
             apair_wide zr = creal(e), zi = cimag(e), m = zr * zr + zi * zi;
             apair_wide ar = creal(a), ai = cimag(a), br = creal(b), bi = cimag(b);
-            lr += ar * zr - ai * zi + (br * zr + bi * zi) / m; /* b / z = b conj(z) / |z|^2 */
-            li += ar * zi + ai * zr + (bi * zr - br * zi) / m;
+            lr += ar * zr - ai * zi + (k ? (br * zr + bi * zi) / m : br); /* b / z = b conj(z) / |z|^2; a P-pair's b */
+            li += ar * zi + ai * zr + (k ? (bi * zr - br * zi) / m : bi);
         }
         cplx mu = sl->times_lambda ? v[n] : 1.0, c = pair_at(sl->t0, 0) + s * pair_at(sl->dt, 0);
         apair_wide mr = creal(mu), mi = cimag(mu);
@@ -187,11 +201,18 @@ static int residual_wide(const tracker *tr, const cplx *v, double tau, cplx *H)
     return 0;
 }
 
-/* The largest |Im theta_i| of a point (its angles: lambda is no angle). */
+/* How far out joint i's variable is: |Im theta| of an angle; log |x| (0 within |x| <= 1) of a
+ * P-pair's slide x, which goes to infinity as exp(i theta / 2) goes to 0 or infinity. */
+static double joint_far(const tracker *tr, const cplx *v, int i)
+{
+    return tr->pb->kind[i] == KIND_P ? fmax(0.0, log(cabs(v[i]))) : fabs(cimag(v[i]));
+}
+
+/* The farthest out of a point's joints (joint_far; lambda is no joint). */
 static double far_of(const tracker *tr, const cplx *v)
 {
     double far = 0.0;
-    for (int i = 0; i < tr->pb->n; i++) far = fmax(far, fabs(cimag(v[i])));
+    for (int i = 0; i < tr->pb->n; i++) far = fmax(far, joint_far(tr, v, i));
     return far;
 }
 
@@ -289,12 +310,13 @@ static int regular_far(const tracker *tr, const apair_ik_options *opt, const cpl
     return d <= opt->final_tol * size && cnorm(n, e) <= 1e-10 * size;
 }
 
-/* The endgame's samples of one path: the last one (L = log(1 - tau), the angles) and the slope
- * over the interval that ended there. */
+/* The endgame's samples of one path: the last one (L = log(1 - tau), the angles, a P-pair's slide
+ * x as the angle i log x, continued from sample to sample, and x itself) and the slope over the
+ * interval that ended there. */
 typedef struct {
     int samples;
     double L;
-    cplx v[NMAX], beta[NMAX];
+    cplx v[NMAX], x[NMAX], beta[NMAX];
 } endgame;
 
 /* Whether the path is going to infinity (an endgame in L = log(1 - tau), from tau >= ENDGAME). Near
@@ -318,16 +340,19 @@ static int to_infinity(endgame *eg, const tracker *tr, const cplx *v, double tau
     double L = log1p(-tau);
     if (eg->samples && eg->L - L < LN2) return 0;
     int verdict = 0;
+    cplx c[NMAX]; /* the angles, a P-pair's slide as i log x (Im: log |x|) */
+    for (int i = 0; i < n; i++)
+        c[i] = tr->pb->kind[i] != KIND_P ? v[i] : eg->samples ? eg->v[i] + I * clog(v[i] / eg->x[i]) : I * clog(v[i]);
     if (eg->samples) {
         cplx beta[NMAX];
         double far = -1.0;
         int j = 0;
         for (int i = 0; i < n; i++) {
-            beta[i] = (v[i] - eg->v[i]) / (L - eg->L);
-            if (fabs(cimag(v[i])) > far) { far = fabs(cimag(v[i])); j = i; }
+            beta[i] = (c[i] - eg->v[i]) / (L - eg->L);
+            if (joint_far(tr, v, i) > far) { far = joint_far(tr, v, i); j = i; }
         }
         if (eg->samples >= 2 && far > ENDGAME_FAR) {
-            double sign = cimag(v[j]) > 0 ? -1.0 : 1.0; /* outward: |Im theta_j| grows as L drops */
+            double sign = cimag(c[j]) > 0 ? -1.0 : 1.0; /* outward: |Im theta_j| grows as L drops */
             double out = sign * cimag(beta[j]), out0 = sign * cimag(eg->beta[j]), size = cabs(beta[j]);
             double reach = size * LN2 * ENDGAME_RATIO / (1.0 - ENDGAME_RATIO);
             verdict = out >= ENDGAME_SLOPE && out >= ENDGAME_RATIO * out0 && cabs(beta[j] - eg->beta[j]) <= 0.5 * size &&
@@ -336,7 +361,8 @@ static int to_infinity(endgame *eg, const tracker *tr, const cplx *v, double tau
         memcpy(eg->beta, beta, n * sizeof(cplx));
     }
     eg->L = L;
-    memcpy(eg->v, v, n * sizeof(cplx));
+    memcpy(eg->v, c, n * sizeof(cplx));
+    memcpy(eg->x, v, n * sizeof(cplx));
     eg->samples++;
     return verdict;
 }
@@ -448,13 +474,15 @@ static int setup(tracker *tr, const apair_ik_problem *pb, const double *p0, cons
     tr->law[0] = apair_find_kernel("ik_law_revolute");
     tr->law[1] = apair_find_kernel("ik_law_sinusoidal");
     if (!tr->sys || !tr->law[0] || !tr->law[1] || tr->sys->n_invariants > INV_MAX) return -1;
-    for (int i = 0; i < pb->n; i++)
-        if (pb->kind[i] != 0 && pb->kind[i] != 1) return -1;
+    for (int i = 0; i < pb->n; i++) {
+        if (pb->kind[i] != 0 && pb->kind[i] != KIND_A && pb->kind[i] != KIND_P) return -1;
+        tr->h[i] = pb->kind[i] == KIND_A ? pb->pair[2 * i] : 0.0;
+        tr->turning[i] = pb->kind[i] == KIND_P ? 0.0 : 1.0;
+    }
     if (tr->sys->n_invariants) {
-        const double *in[4] = {NULL, NULL, NULL, pb->dh};
+        const double *in[5] = {NULL, NULL, NULL, pb->dh, tr->turning};
         tr->sys->invariants(in, tr->inv);
     }
-    for (int i = 0; i < pb->n; i++) tr->h[i] = pb->kind[i] ? pb->pair[2 * i] : 0.0;
     apair_ik_residual6_invariants(tr->h, pb->dh, tr->inv_res);
     for (int k = 0; k < 7; k++) {
         tr->p0[k] = p0[2 * k] + I * p0[2 * k + 1];

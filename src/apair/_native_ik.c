@@ -194,7 +194,7 @@ static const ik_entry ik_entries[] = {
         .out = {{"end", C128, 2, {ROWS, 6}}, {"status", I32, 1, {ROWS}}, {"steps", I32, 1, {ROWS}},
                 {"cond", F64, 1, {ROWS}}},
         .rows = 6, .nogil = 1, .run = run_track,
-        .error = "ik_track: the problem is not valid (kinds 0 or 1, 6 joints)",
+        .error = "ik_track: the problem is not valid (kinds 0, 1 or 4, 6 joints)",
     },
     [IK_TRACK_SLICE] = {
         .format = "OOOOOOODDpDO", /* kind, pair, dh, p, w, ell, dell, t0, dt, times_lambda, gamma, start */
@@ -204,7 +204,7 @@ static const ik_entry ik_entries[] = {
         .out = {{"end", C128, 2, {ROWS, 7}}, {"status", I32, 1, {ROWS}}, {"steps", I32, 1, {ROWS}},
                 {"cond", F64, 1, {ROWS}}},
         .rows = 11, .nogil = 1, .run = run_track_slice,
-        .error = "ik_track_slice: the problem is not valid (kinds 0 or 1, 6 joints)",
+        .error = "ik_track_slice: the problem is not valid (kinds 0, 1 or 4, 6 joints)",
     },
     [IK6R_ANGLES] = {
         .format = "OOOOOOO",
@@ -219,7 +219,7 @@ static const ik_entry ik_entries[] = {
                    {"theta", C128, 2, {ANY, 6}}},
         .out = {{"theta", C128, 2, {ROWS, 6}}, {"size", F64, 1, {ROWS}}},
         .rows = 4, .nogil = 1, .run = run_newton,
-        .error = "ik_newton: the problem is not valid (kinds 0 or 1, 6 joints)",
+        .error = "ik_newton: the problem is not valid (kinds 0, 1 or 4, 6 joints)",
     },
     [IK_LOCAL] = {
         .format = "OOOOOdOOdi", /* kind, pair, dh, lower, upper, scale, target, seed, tol, max_iter */

@@ -605,7 +605,8 @@ class AChain:
         base⁻¹·T·tool⁻¹ in frame 0, where the check and `error` are measured).
         within_limits=True keeps only the solutions inside `limits` (no collisions).
 
-        Chains of 1 to 6 sinusoidal A-pairs or R-pairs (7 with `fix`). n ≤ 4 by kinematic mapping (see
+        Chains of 1 to 6 sinusoidal A-, R- or P-pairs (7 with `fix`; P-pairs by the homotopy, any n,
+        their slides in m, any real value). Otherwise n ≤ 4 by kinematic mapping (see
         apair.ik.elimination4): the left half's constraint variety on the right part's image,
         eliminated to eigenvalue and univariate problems. 5 and 6 R-pairs by the 6R elimination
         (apair.ik.elimination6r) where it certifies its 16 solutions, chains with one A-pair by
@@ -661,7 +662,7 @@ class AChain:
     def prepare_ik(
         self, progress: Callable[[int, int], object] | None = None, refresh: bool = False, trace: bool = False
     ) -> StartSystem:
-        """n = 5, 6: the design's homotopy start system (every complex solution at a generic complex
+        """n = 5, 6 or a P-pair: the design's homotopy start system (every complex solution at a generic complex
         pose, by monodromy), from the cache or computed now and cached (`apair ik-prepare`).
         trace: also run the trace test (apair.ik.homotopy.trace: seconds up to 48 solutions, minutes
         and maybe no verdict for more, refused above 200), whose verdict is cached with the set and
@@ -670,7 +671,7 @@ class AChain:
         .trace)."""
         from .ik import homotopy
 
-        if not 5 <= self.n <= 6:
+        if not 5 <= self.n <= 6 and not (self.n < 5 and any(p.kind == "prismatic" for p in self.pairs)):
             raise ValueError(
                 f"chain: start systems are for 5 and 6 joints (this chain has {self.n}; its ik is "
                 + ("solved by elimination)" if self.n < 5 else "solved with fix={k: value}, one joint held)")

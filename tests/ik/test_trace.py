@@ -79,8 +79,8 @@ def test_slice_tracker_c_matches_numpy():
     X0 = np.concatenate([start.solutions, np.zeros((start.count, 1))], axis=1)
     family = trace.Slice(problem, start.p0, w, ell, np.zeros_like(ell), 0, 0.7 + 0.2j, True)
     X1, status, _, _ = family.track_once(0.8 + 0.6j, X0, engine="c")
-    z, _ = trace.coordinates(problem, X1[:, :6])
-    ell1 = ell / np.sum(ell[0] * z[0] + ell[1] / z[0])  # ℓ1 = 1 at the first point, ℓ − 1 = −0.7/λ at the others
+    z, w1, _, _ = trace.coordinates(problem, X1[:, :6])
+    ell1 = ell / np.sum(ell[0] * z[0] + ell[1] * w1[0])  # ℓ1 = 1 at the first point, ℓ − 1 = −0.7/λ at the others
     move = trace.Slice(problem, start.p0, w, ell1, ell - ell1, 0, 0, False)
     for sl, X in ((family, X0), (move, X1[:1])):
         c = sl.track_once(0.8 + 0.6j, X, engine="c")

@@ -78,8 +78,8 @@ _PROBE = np.random.default_rng(1).standard_normal((12, 1))  # inverse iteration'
 
 
 def applies(problem) -> bool:
-    """Whether the problem (virtual joints included) has six joints, exactly one an A-pair."""
-    return problem.n == 6 and int(np.count_nonzero(problem.kind)) == 1
+    """Whether the problem (virtual joints included) has six joints, one an A-pair, the others R-pairs."""
+    return problem.n == 6 and int(np.count_nonzero(problem.kind == 1)) == 1 and not np.any(problem.kind > 1)
 
 
 def _rotations(psi: np.ndarray, alpha: np.ndarray) -> np.ndarray:

@@ -4,8 +4,10 @@ method by the chain's shape. 1 to 4 joints: the elimination by kinematic mapping
 (apair.ik.local) whose answer is not certified complete; 5 and 6 joints: the 6R elimination
 (apair.ik.elimination6r), the one-A-pair elimination (apair.ik.elimination1a5r), else parameter
 homotopy from the design's start system (apair.ik.homotopy; at a singular pose, where its paths
-do not account for every start solution, by way of a pose moved by 1e-6). Every real candidate is
-verified and refined by apair.ik.poses.refine.
+do not account for every start solution, by way of a pose moved by 1e-6). Chains with P-pairs of
+any length go to the homotopy (1 to 4 joints with the virtual joints it appends), whose unknown
+at a P-pair is its slide in units of L. Every real candidate is verified and refined by
+apair.ik.poses.refine.
 
 Every method works on the chain in units of its length scale L (apair.ik.poses.length_scale: the
 pose's translation divided by L, the design's lengths too), and the tolerances on translations
@@ -15,6 +17,7 @@ scaled by s. A pose beyond the chain's reach bound is answered without any elimi
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -85,6 +88,7 @@ class _UnitDesign:
     alpha: np.ndarray
     offset: np.ndarray
     theta_offset: np.ndarray
+    limits: list[tuple[float, float]]  # a P-pair's range in units of the scale (the others' as they are)
 
     @property
     def n(self) -> int:
@@ -92,8 +96,12 @@ class _UnitDesign:
 
     @staticmethod
     def of(chain: ChainLike, scale: float) -> _UnitDesign:
-        pairs = [_Pair(p.kind, p.amplitude / scale) for p in chain.pairs]
-        return _UnitDesign(pairs, chain.a / scale, chain.alpha, chain.offset / scale, chain.theta_offset)
+        pairs = [_Pair(p.kind, 0.0 if p.kind == "prismatic" else p.amplitude / scale) for p in chain.pairs]
+        limits = [
+            (lo / scale, hi / scale) if p.kind == "prismatic" else (lo, hi)
+            for p, (lo, hi) in zip(chain.pairs, chain.limits)
+        ]
+        return _UnitDesign(pairs, chain.a / scale, chain.alpha, chain.offset / scale, chain.theta_offset, limits)
 
 
 class Solver:
@@ -120,14 +128,11 @@ class Solver:
                     f"pairs[{i}]: a helical pair's d = pitch*theta is not algebraic in the angle's half "
                     "tangent, so all-solutions inverse kinematics does not apply; use ik_local(T, q0)"
                 )
-            if p.kind == "prismatic":
-                raise ValueError(
-                    f"pairs[{i}]: all-solutions inverse kinematics of chains with prismatic pairs is not "
-                    "built yet; use ik_local(T, q0)"
-                )
         self.chain = chain
         self.scale = length_scale(chain)
-        self.reach = reach_of(chain)
+        self.slides = np.array([p.kind == "prismatic" for p in chain.pairs])
+        # the reach bound counts a P-pair's slide within its limits; its solutions are any real d
+        self.reach = math.inf if self.slides.any() else reach_of(chain)
         self.seed = seed
         self._eliminations: dict[bool, Elimination] = {}
         self._problem: Problem | None = None  # n = 5, 6: the homotopy.Problem
@@ -146,14 +151,14 @@ class Solver:
         if self._beyond_reach(pose.matrix, count_complex):
             n = self.chain.n
             return Solution(np.zeros((0, n)), np.zeros(0), 0, None, method="reach bound")
-        if self.chain.n >= 5:
+        if self.chain.n >= 5 or self.slides.any():
             return self._solve_homotopy(pose, tol)
         return self._solve_elimination(pose, tol, count_complex)
 
     def _beyond_reach(self, Tm: NDArray[np.float64], count_complex: bool) -> bool:
         """Whether the pose is answered by the reach bound alone: beyond it (where only a count of
         the complex solutions needs an elimination) or beyond FAR times it."""
-        if near_reach(self.chain, Tm, self.reach, self.scale):
+        if not math.isfinite(self.reach) or near_reach(self.chain, Tm, self.reach, self.scale):
             return False
         return not count_complex or translation_norm(Tm) > FAR * (self.reach + self.scale)
 
@@ -218,10 +223,11 @@ class Solver:
         return Solution(q, err, 0, None, certified=False, method="local search", note=note)
 
     def _solve_homotopy(self, pose: Pose, tol: float) -> Solution:
-        """n = 5, 6: R-chains by the 6R elimination (apair.ik.elimination6r) where it certifies its
-        16 solutions, chains with one A-pair by theirs (apair.ik.elimination1a5r, 48); otherwise
-        every start solution tracked to T (apair.ik.homotopy). Real solutions verified. All three
-        work on the design in units of its length scale (`_UnitDesign`) and T's translation too."""
+        """n = 5, 6 and chains with P-pairs: R-chains by the 6R elimination
+        (apair.ik.elimination6r) where it certifies its 16 solutions, chains with one A-pair by
+        theirs (apair.ik.elimination1a5r, 48); otherwise every start solution tracked to T
+        (apair.ik.homotopy). Real solutions verified. All three work on the design in units of its
+        length scale (`_UnitDesign`) and T's translation too (a P-pair's slide is read back in m)."""
         Tm = pose.matrix
         Tu = Tm.copy()
         Tu[:3, 3] /= self.scale
@@ -238,7 +244,7 @@ class Solver:
         else:
             theta, complete, note = self._homotopy(problem, Tu, Tm, tol)
             method = "homotopy"
-        real = homotopy.real_angles(problem, theta)
+        real = self._joint_values(homotopy.real_angles(problem, theta))
         q, err = refine(self.chain, real, Tm, tol, self.scale)
         return Solution(q, err, len(real), len(theta), certified=complete, method=method, note=note)
 
@@ -274,7 +280,7 @@ class Solver:
         singular = ends.theta[ends.singular] if ends.singular is not None else ends.theta[:0]
         if len(singular) == 0:
             return
-        q = homotopy.real_angles(problem, singular.real.astype(complex))
+        q = self._joint_values(homotopy.real_angles(problem, singular.real.astype(complex)))
         q, _ = refine(self.chain, local_search(self.chain, Tm, start=q), Tm, tol, self.scale)
         for k in np.flatnonzero(jacobian_rank(self.chain, q, self.scale) < self.chain.n):
             if on_continuum(self.chain, q[k], Tm, tol):
@@ -282,6 +288,11 @@ class Solver:
                     "T: the solutions at this pose are not isolated: they form a curve (e.g. a wrist "
                     "singularity, two R-pair axes in line)"
                 )
+
+    def _joint_values(self, real: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The homotopy's real joint values (m, n) as the chain's: a P-pair's slide from units of
+        the length scale to metres (angles as they are)."""
+        return np.where(self.slides, real * self.scale, real)
 
 
 def _unaccounted(ends: Endpoints) -> str:

@@ -1,4 +1,7 @@
-"""Every complex solution of an R/A chain's inverse kinematics by parameter homotopy (n = 1..6).
+"""Every complex solution of an R/A/P chain's inverse kinematics by parameter homotopy (n = 1..6).
+
+A P-pair's unknown is its slide x in units of the chain's scale (no period; "far out" by log |x|,
+`problem.far_of`); below, "angles" include it.
 
 The equations (derivations/chain_ik.py, kernel ik_system6) are F(θ; t, q) = 0: the chain's end
 frame at the pose with translation t and rotation quaternion q (up to scale), over the complex
@@ -14,7 +17,9 @@ reaches all of it:
   first `ik`). A chain of n < 6 joints reaches only an n-dimensional family of poses; it is
   tracked as a 6-joint chain, with 6 − n fixed virtual R-pairs of generic geometry appended
   (`VIRTUAL`), at the target T·A_virtual(0): its solutions with the virtual joints at 0 are the
-  chain's solutions at T, and the others are discarded.
+  chain's solutions at T, and the others are discarded. Its last joint's Tx(a)·Rx(α) is tracked
+  as a fixed generic one (`TURN`), the target moved by the constant difference (`Problem.tail`),
+  so that the first virtual axis is never that joint's own (α = 0, a = 0: a curve of solutions).
 - **Per pose**: the start solutions are tracked from p0 to the target with a random γ (path
   p0 + s (p1 − p0), s = γτ/(1 + (γ − 1)τ)), in C (`apair_ik_track`: RK4 predictor, Newton
   corrector, Newton refinement and a condition number at the end), or by `track_numpy` without

@@ -1,6 +1,7 @@
 """The generic number of complex inverse-kinematics solutions of every R/A pattern of 1 to 6 joints,
-computed by the machinery `AChain.ik` uses (apair.ik.homotopy): `make ik-counts` (python -m
-apair.ik.homotopy.counts) writes generated/ik_counts.json, and `apair show ik_counts` prints it.
+and of the patterns with P-pairs in `WITH_SLIDES`, computed by the machinery `AChain.ik` uses
+(apair.ik.homotopy): `make ik-counts` (python -m apair.ik.homotopy.counts) writes
+generated/ik_counts.json, and `apair show ik_counts` prints it.
 
 Each pattern gets a random design of generic geometry (no zero lengths, no parallel or
 perpendicular axes). Its start system (the complete solution set at a generic complex pose, by
@@ -41,24 +42,41 @@ from .trace import certify
 from .tracker import FAILED, OK, RETRIES
 
 KNOWN = {"RRRRRR": 16}  # Lee & Liang 1988, Raghavan & Roth 1993
+# Patterns with P-pairs (P: its slide the joint's variable): a SCARA's (its count for the pattern as
+# written, as for every n < 6), the Stanford arm's and one with an A-pair (first of it and its reverse).
+WITH_SLIDES = ("RRPR", "ARPRRR", "RRPRRR")
 
 
 def patterns(max_n: int = 6) -> list[str]:
-    """Every pattern up to reversal (the first of p and p[::-1]), by length then alphabetically."""
+    """Every R/A pattern up to reversal (the first of p and p[::-1]), by length then alphabetically,
+    with those of WITH_SLIDES after the R/A ones of their length."""
     out = []
     for n in range(1, max_n + 1):
         for letters in itertools.product("AR", repeat=n):
             p = "".join(letters)
             if p <= p[::-1]:
                 out.append(p)
+        out += [p for p in WITH_SLIDES if len(p) == n]
     return out
 
 
 def design(pattern: str, seed: int = 0):
-    """A chain of the pattern with random generic geometry."""
-    rng = np.random.default_rng([seed, len(pattern), int(pattern.replace("A", "1").replace("R", "0"), 2)])
+    """A chain of the pattern with random generic geometry (a P-pair's range ±1 m, which the
+    counts do not depend on)."""
+    if "P" in pattern:  # R/A patterns keep the designs their stored counts were computed on
+        code = [int(pattern.translate(str.maketrans("RAP", "012")), 3), 3]
+    else:
+        code = [int(pattern.replace("A", "1").replace("R", "0"), 2)]
+    rng = np.random.default_rng([seed, len(pattern), *code])
     n = len(pattern)
-    pairs = [APair.revolute() if c == "R" else APair(rng.uniform(0.2, 0.4), rng.uniform(0.15, 0.35)) for c in pattern]
+    pairs = [
+        APair.revolute()
+        if c == "R"
+        else APair.prismatic()
+        if c == "P"
+        else APair(rng.uniform(0.2, 0.4), rng.uniform(0.15, 0.35))
+        for c in pattern
+    ]
     alpha = rng.uniform(0.3, 1.3, n) * rng.choice([-1, 1], n)
     return AChain(
         pairs,
@@ -66,6 +84,7 @@ def design(pattern: str, seed: int = 0):
         alpha=alpha,
         offset=rng.uniform(-0.5, 0.5, n),
         theta_offset=rng.uniform(-np.pi, np.pi, n),
+        limits=[(-1.0, 1.0) if c == "P" else None for c in pattern],
     )
 
 
@@ -74,6 +93,7 @@ def reachable_pose(problem: Problem, rng) -> np.ndarray:
     chain, the virtual joints at 0."""
     theta = np.zeros(problem.n, complex)
     theta[: problem.joints] = rng.uniform(-np.pi, np.pi, problem.joints) + 0.3j * rng.standard_normal(problem.joints)
+    # (a P-pair's slide drawn alike: any complex value is a joint value)
     A, b = linear_pose(problem, theta)
     p, *_ = np.linalg.lstsq(A, -b, rcond=None)
     _, sv, Vh = np.linalg.svd(A)
@@ -154,7 +174,7 @@ def main(argv=None) -> int:
         if p not in known:
             parser.error(
                 f"--only: {p!r} is not a stored pattern of 1 to {args.max_n} joints (A and R, the first "
-                f"of a pattern and its reverse)"
+                f"of a pattern and its reverse, or one of {', '.join(WITH_SLIDES)})"
             )
     old = {}
     if args.update or args.only:

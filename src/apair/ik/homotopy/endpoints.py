@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import tracker
-from .problem import Index, Problem, canonical, own_rows
+from .problem import Index, Problem, canonical, far_of, own_rows
 from .startsets import StartSystem
 from .tracker import DIVERGED, ENDGAME_FAR, OK, RETRIES, SINGULAR, TOO_LONG, WIDE_POSE, unit_gamma
 
@@ -91,7 +91,7 @@ class _Pool:
             chain = []
             for endpoint, st in zip(canonical(problem, e), s):
                 if st not in (OK, SINGULAR):
-                    far = _far(endpoint, st)
+                    far = _far(problem, endpoint, st)
                     failed |= not far
                     ends += far
                     continue
@@ -109,9 +109,9 @@ class _Pool:
             wave = chain
         return failed, ends
 
-    def near(self) -> int:
+    def near(self, problem: Problem) -> int:
         """The distinct endpoints found within ENDGAME_FAR (the ones that can be real)."""
-        return sum(bool(np.abs(t.imag).max() <= ENDGAME_FAR) for t in self.found.rows)
+        return sum(bool(far_of(problem, t) <= ENDGAME_FAR) for t in self.found.rows)
 
 
 def solve(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 0) -> Endpoints:
@@ -159,7 +159,7 @@ def _pooled(problem: Problem, start: StartSystem, p1: np.ndarray, seed: int) -> 
             break
         failed, ends = pool.retrack(problem, start, p1, unit_gamma(rng), missing)
         if not failed:
-            clean.append((pool.near(), len(pool.found.rows) + ends, ends))
+            clean.append((pool.near(problem), len(pool.found.rows) + ends, ends))
     confirmed = _confirmed(clean, start.count)
     infinite = min(clean[-1][2], start.count - len(pool.found.rows)) if confirmed else 0
     complete = start.certified and (len(pool.found.rows) >= start.count or confirmed)
@@ -180,7 +180,7 @@ def solve_near(problem: Problem, start: StartSystem, T: np.ndarray, seed: int = 
     rng = np.random.default_rng([seed, 11])
     pool, complete, infinite = _pooled(problem, start, problem.target(_moved(T, NEAR, rng)), seed)
     theta = np.array(pool.found.rows).reshape(-1, problem.n)
-    theta = theta[np.all(np.abs(theta.imag) <= NEAR_REAL, axis=1)]
+    theta = theta[np.all(np.abs(theta.imag) <= NEAR_REAL, axis=1) & (far_of(problem, theta) <= ENDGAME_FAR)]
     steps, tol, floor, stall, converged = NEWTON
     theta, size = tracker.newton(problem, theta, problem.target(T), steps, tol, floor, stall, 2 * NEAR_REAL)
     ok = size <= converged
@@ -216,13 +216,13 @@ def _moved(T: np.ndarray, by: float, rng: np.random.Generator) -> np.ndarray:
     return out
 
 
-def _far(endpoint: np.ndarray, status: int) -> bool:
+def _far(problem: Problem, endpoint: np.ndarray, status: int) -> bool:
     """Whether a path that did not end regularly ended "far": found going to infinity (DIVERGED),
     or given up crawling in extended precision (TOO_LONG) beyond ENDGAME_FAR, where the tracker may
     end a path found going to infinity. Such paths, and the endpoints beyond ENDGAME_FAR, are taken
     alike (see `_confirmed`): none of them is real, and double precision cannot tell a finite point
     that far out from infinity."""
-    return status == DIVERGED or (status == TOO_LONG and bool(np.abs(endpoint.imag).max() > ENDGAME_FAR))
+    return status == DIVERGED or (status == TOO_LONG and bool(far_of(problem, endpoint) > ENDGAME_FAR))
 
 
 def _confirmed(clean: list[tuple[int, int, int]], count: int) -> bool:

@@ -2,6 +2,8 @@
 joints, the virtual ones last, lengths in units of the chain's scale), its equations F(θ; t, q) by
 the generated kernels (`law`, `system`), the pose coordinates (t, q), and when two complex angle
 vectors are one solution (`canonical`, `Index`; the chain's own among the six-joint ones: `own`).
+A P-pair's variable is its slide x in units of the scale (its angle held at θ_offset): "angles"
+below include it, with no period, and how far out it is is log |x| (`far_of`).
 """
 
 from __future__ import annotations
@@ -19,11 +21,16 @@ SAME = 1e-4  # two endpoints whose angles differ by less than this are one solut
 LOOSE = 1e-2  # the same for an endpoint not refined to full accuracy (far out, they are off by up to 1e-3)
 VIRTUAL_ZERO = 1e-6  # |exp(iθ) − 1| under which a virtual joint is at 0
 REAL = 1e-5  # |Im θ| under which an endpoint is a real candidate (fk verifies it)
+KINDS = {"revolute": 0, "sinusoidal": 1, "prismatic": 4}  # the problem's joint kinds (apair_ik_problem)
+LETTERS = {0: "R", 1: "A", 4: "P"}  # a kind's letter in a pattern (apair show ik_counts)
+R_PAIR, A_PAIR, P_PAIR = 0, 1, 4
 
 
 def scale_of(chain) -> float:
-    """The chain's length scale: its largest link length, offset or amplitude (at least 1 mm)."""
-    lengths = [abs(x) for x in (*chain.a, *chain.offset)] + [p.amplitude for p in chain.pairs]
+    """The chain's length scale: its largest link length, offset, amplitude or end of a P-pair's
+    range (at least 1 mm), as apair.ik.poses.length_scale takes it."""
+    lengths = [abs(x) for x in (*chain.a, *chain.offset)] + [_amplitude(p) for p in chain.pairs]
+    lengths += [max(abs(lo), abs(hi)) for p, (lo, hi) in zip(chain.pairs, chain.limits) if p.kind == "prismatic"]
     return max(max(lengths), 1e-3)
 
 
@@ -32,33 +39,58 @@ class Problem:
     """A chain's design as the tracker takes it (6 joints, the virtual ones last), lengths in units
     of `scale`; `joints` is the chain's own n."""
 
-    kind: np.ndarray  # int32 (6,): 0 R-pair, 1 sinusoidal A-pair
+    kind: np.ndarray  # int32 (6,): 0 R-pair, 1 sinusoidal A-pair, 4 P-pair
     pair: np.ndarray  # (6, 2): (h, 0)
     dh: np.ndarray  # (6, 4)
     scale: float
     joints: int
+    tail: np.ndarray | None = None  # n < 6: the fixed transform T·tail that the turned last joint reaches (`of`)
 
     @property
     def n(self) -> int:
         return len(self.kind)
 
+    @property
+    def slides(self) -> np.ndarray:
+        """(n,) bool: the joints whose variable is a P-pair's slide (no period, no angle)."""
+        return self.kind == P_PAIR
+
+    @property
+    def turning(self) -> np.ndarray:
+        """(n,) ik_system's turning factors: 0 for a P-pair, else 1."""
+        return np.where(self.slides, 0.0, 1.0)
+
+    @property
+    def pattern(self) -> str:
+        """The chain's own joints as letters (R, A, P), as generated/ik_counts.json names them."""
+        return "".join(LETTERS[int(k)] for k in self.kind[: self.joints])
+
     @staticmethod
     def of(chain) -> Problem:
         for i, p in enumerate(chain.pairs):
-            if p.kind == "general":
+            if p.kind not in KINDS:
                 raise ValueError(
-                    f"pairs[{i}]: a general A-pair's motion is not rational; inverse kinematics "
-                    "needs sinusoidal A-pairs or R-pairs"
+                    f"pairs[{i}]: a {p.kind} pair's motion is not algebraic in the angle's half tangent; "
+                    "inverse kinematics needs sinusoidal A-pairs, R-pairs or P-pairs"
                 )
         s = scale_of(chain)
-        kind = [0 if p.kind == "revolute" else 1 for p in chain.pairs]
-        pair = [[p.amplitude / s, 0.0] for p in chain.pairs]
+        kind = [KINDS[p.kind] for p in chain.pairs]
+        pair = [[_amplitude(p) / s, 0.0] for p in chain.pairs]
         dh = [[a / s, al, c / s, ph] for a, al, c, ph in zip(chain.a, chain.alpha, chain.offset, chain.theta_offset)]
         extra = 6 - chain.n
+        tail = None
+        if extra:
+            # the last joint's Tx(a)·Rx(α) turned to TURN's, so that the first virtual axis is generic
+            # to it (with α = 0 and a = 0 it would be that joint's own axis: a curve of solutions):
+            # frame n = (the turned frame)·K, K = Rx(−α')·Tx(a − a')·Rx(α), so the turned chain
+            # reaches T·K⁻¹
+            a, alpha = dh[-1][0], dh[-1][1]
+            tail = _dh(0.0, 0.0, -alpha, 0.0, 0.0) @ _dh(0.0, TURN[0] - a, TURN[1], 0.0, 0.0)
+            dh[-1][:2] = TURN
         kind += [0] * extra
         pair += [[0.0, 0.0]] * extra
         dh += [list(row) for row in VIRTUAL[:extra]]
-        return Problem(np.array(kind, np.int32), np.array(pair, float), np.array(dh, float), s, chain.n)
+        return Problem(np.array(kind, np.int32), np.array(pair, float), np.array(dh, float), s, chain.n, tail)
 
     def key(self) -> str:
         """What the start system depends on, as text (floats exactly)."""
@@ -76,6 +108,8 @@ class Problem:
         units of scale, times the virtual joints at 0."""
         Ts = np.array(T, float)
         Ts[:3, 3] /= self.scale
+        if self.tail is not None:
+            Ts = Ts @ self.tail
         for a, alpha, c, phi in self.dh[self.joints :]:
             Ts = Ts @ _dh(0.0, a, alpha, c, phi)
         return Ts
@@ -83,6 +117,11 @@ class Problem:
     def target(self, T: np.ndarray) -> np.ndarray:
         """pose(T) as (t, q) (7,), the homotopy's pose coordinates."""
         return target_of(self.pose(T))
+
+
+def _amplitude(pair) -> float:
+    """A pair's amplitude h, 0 for a P-pair (its slide is the joint's variable)."""
+    return 0.0 if pair.kind == "prismatic" else pair.amplitude
 
 
 def target_of(pose: np.ndarray) -> np.ndarray:
@@ -95,6 +134,8 @@ def _dh(theta, a, alpha, c, phi) -> np.ndarray:
     ct, st, ca, sa = math.cos(theta + phi), math.sin(theta + phi), math.cos(alpha), math.sin(alpha)
     return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, c], [0, 0, 0, 1]])
 
+
+TURN = (0.43, 0.97)  # n < 6: the last joint's (a, α) in the tracked chain (units of the scale; `Problem.of`)
 
 # The virtual joints that complete a chain of n < 6 joints (a, α, c, φ in units of the chain's
 # scale): fixed, of generic geometry (no zero, parallel or perpendicular axes), so that the start
@@ -109,10 +150,16 @@ VIRTUAL = (
 
 
 def law(problem: Problem, theta: np.ndarray):
-    """(cos(θ/2), sin(θ/2), d, d') (…, n, 4) at complex angles θ (…, n), by the ik_law kernels."""
-    v = np.exp(0.5j * np.asarray(theta))
+    """(cos(θ/2), sin(θ/2), d, d') (…, n, 4) at complex angles θ (…, n), by the ik_law kernels; a
+    P-pair's (1, 0, x, 1) at its slide x."""
+    theta = np.asarray(theta)
+    v = np.exp(0.5j * np.where(problem.slides, 0, theta))
     out = np.empty(v.shape + (4,), complex)
-    for k in (0, 1):  # one call per kind of pair, over its joints
+    idx = np.flatnonzero(problem.slides)
+    if len(idx):
+        out[..., idx, :] = [1, 0, 0, 1]
+        out[..., idx, 2] = theta[..., idx]
+    for k in (R_PAIR, A_PAIR):  # one call per kind of pair, over its joints
         idx = np.flatnonzero(problem.kind == k)
         if len(idx) == 0:
             continue
@@ -139,7 +186,9 @@ def complex_of(a: np.ndarray) -> np.ndarray:
 def system(problem: Problem, theta: np.ndarray, target: np.ndarray, direction: np.ndarray):
     """F (6,), dF/dθ (6, n) and dF/d(direction) (6,) at one point (the generated kernel)."""
     lw = law(problem, theta)
-    F, dF, dFs = kernels.call(f"ik_system{problem.n}", pairs_of(lw), pairs_of(target), pairs_of(direction), problem.dh)
+    F, dF, dFs = kernels.call(
+        f"ik_system{problem.n}", pairs_of(lw), pairs_of(target), pairs_of(direction), problem.dh, problem.turning
+    )
     return complex_of(F), complex_of(dF), complex_of(dFs)
 
 
@@ -163,22 +212,35 @@ def _distinct(sols: np.ndarray, known: np.ndarray | None = None) -> np.ndarray:
 
 
 def canonical(problem: Problem, theta: np.ndarray) -> np.ndarray:
-    """θ with its real part in (−π, π] (R-pair) or (−2π, 2π] (A-pair), the imaginary part kept."""
-    half = np.where(problem.kind == 0, np.pi, 2 * np.pi)
+    """θ with its real part in (−π, π] (R-pair) or (−2π, 2π] (A-pair), the imaginary part kept (a
+    P-pair's slide as it is)."""
+    half = np.where(problem.kind == R_PAIR, np.pi, 2 * np.pi)
     re = np.real(theta)
     with np.errstate(invalid="ignore"):  # a failed path's endpoint (NaN, inf) stays what it is
-        return (re - 2 * half * np.ceil((re - half) / (2 * half))) + 1j * np.imag(theta)
+        wrapped = re - 2 * half * np.ceil((re - half) / (2 * half))
+        return np.where(problem.slides, re, wrapped) + 1j * np.imag(theta)
+
+
+def far_of(problem: Problem, theta: np.ndarray) -> np.ndarray:
+    """How far out in the complex each point θ (..., n) is (...,): the largest |Im θ| of its angles
+    and log |x| of its P-pairs' slides x (0 within |x| ≤ 1), as the C tracker measures it."""
+    theta = np.asarray(theta)
+    far = np.abs(theta.imag)
+    if problem.slides.any():
+        with np.errstate(divide="ignore", invalid="ignore"):
+            far = np.where(problem.slides, np.maximum(0.0, np.log(np.abs(theta))), far)
+    return far.max(axis=-1)
 
 
 class Index:
     """Solutions (complex angles) with a bucket index on Im θ_1, so that membership tests of
     thousands of them are fast. Two solutions are one when their angles differ by at most SAME in
     every joint (LOOSE if either is `loose`, not refined to full accuracy), the real parts modulo
-    the joint's period (one pose: 2π for an R-pair, 4π for an A-pair)."""
+    the joint's period (one pose: 2π for an R-pair, 4π for an A-pair, none for a P-pair's slide)."""
 
     def __init__(self, problem: Problem):
         self.problem = problem
-        self.period = np.where(problem.kind == 0, 2 * np.pi, 4 * np.pi)
+        self.period = np.where(problem.slides, np.inf, np.where(problem.kind == R_PAIR, 2 * np.pi, 4 * np.pi))
         self.rows: list[np.ndarray] = []
         self.loose: list[bool] = []
         self.buckets: dict = {}
@@ -230,7 +292,8 @@ def own(problem: Problem, theta: np.ndarray) -> np.ndarray:
 
 
 def real_angles(problem: Problem, theta: np.ndarray, tol: float = REAL) -> np.ndarray:
-    """The real endpoints' angles (m, n): (−π, π] for R-pairs, (−2π, 2π] for A-pairs."""
+    """The real endpoints' angles (m, n): (−π, π] for R-pairs, (−2π, 2π] for A-pairs, a P-pair's
+    slide in units of the scale."""
     n = problem.joints
     if len(theta) == 0:
         return np.zeros((0, n))

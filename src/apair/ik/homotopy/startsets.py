@@ -171,7 +171,7 @@ def generic_count(problem: Problem) -> int:
     """The certified generic number of solutions of the problem's pattern from the stored counts,
     or 0. For 6 joints the pattern or its reverse; for fewer, the start set with the virtual joints,
     stored for the pattern as written."""
-    pattern = "".join("A" if k else "R" for k in problem.kind[: problem.joints])
+    pattern = problem.pattern
     rows = stored_counts()
     names = {pattern, pattern[::-1]} if problem.joints == 6 else {pattern}
     return next((int(r["start_count"]) for r in rows if r["pattern"] in names and r["certified"]), 0)

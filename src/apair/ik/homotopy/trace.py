@@ -7,7 +7,8 @@ in the complex can be missed by every run alike. The trace test of Leykin, Rodri
 - Along a random complex line of poses p0 + λ w the solutions form a curve C in (θ, λ),
   irreducible because the solution set over all poses is; the start set S is C ∩ {λ = 0}.
 - A random affine function ℓ of the joints' algebraic coordinates z_j = exp(iθ_j/2) (A-pair; its
-  pose has period 4π) or exp(iθ_j) (R-pair) and of 1/z_j cuts C in the witness points
+  pose has period 4π) or exp(iθ_j) (R-pair) and of 1/z_j (a P-pair: its slide x_j, and 1) cuts C
+  in the witness points
   W = C ∩ {ℓ = 1}, computed by monodromy (`witness_points`): loops through random ℓ, and
   loops through the family f = −t below, which also return any start solution S lacks.
 - On C the function f = (ℓ − 1)·λ vanishes exactly on S ∪ W, and it is proper: every branch of C
@@ -42,7 +43,7 @@ from ... import kernels
 from ...kernels import native_in_use
 from ...study import qmul
 from .monodromy import segment
-from .problem import Index, Problem, canonical, complex_of, law, pairs_of, random_pose
+from .problem import R_PAIR, Index, Problem, canonical, complex_of, law, pairs_of, random_pose
 from .startsets import StartSystem
 from .tracker import OK, RETRIES, SINGULAR, solve_linear, threaded, track_system, unit_gamma
 
@@ -61,15 +62,22 @@ T_LOOP_SCALE = 5.0  # |t| of the monodromy loops through the trace family (befor
 
 
 def coordinates(problem: Problem, theta: np.ndarray):
-    """The algebraic coordinates z (..., 6) of complex angles θ, and the factor k in z = exp(ikθ)."""
-    k = np.where(problem.kind == 0, 1.0, 0.5)
-    return np.exp(1j * k * np.asarray(theta)), k
+    """The algebraic coordinates (z, w) (..., 6) each of complex angles θ and their derivatives in θ
+    (dz, dw): z = exp(ikθ) (k = 1/2 for an A-pair, 1 for an R-pair) and w = 1/z; a P-pair's z = x
+    (its slide) and w = 1."""
+    theta = np.asarray(theta)
+    k = np.where(problem.kind == R_PAIR, 1.0, 0.5)
+    slides = problem.slides
+    e = np.exp(1j * k * np.where(slides, 0, theta))
+    z, w = np.where(slides, theta, e), np.where(slides, 1.0, 1 / e)
+    dz, dw = np.where(slides, 1.0, 1j * k * e), np.where(slides, 0.0, -1j * k / e)
+    return z, w, dz, dw
 
 
 @dataclass(frozen=True)
 class Slice:
     """The system H(θ, λ; s) = [F(θ; p + λ w) ; (ℓ_s(θ) − 1)·μ + t0 + s·dt] in x = (θ, λ) (k, 7),
-    with ℓ_s = ℓ + s·dℓ (coefficients (2, 6): of z and of 1/z) and μ = λ (`times_lambda`: the trace
+    with ℓ_s = ℓ + s·dℓ (coefficients (2, 6): of z and of w, `coordinates`) and μ = λ (`times_lambda`: the trace
     family f = −t) or 1 (monodromy in ℓ). F is ik_system6, linear in the pose, so ∂F/∂λ is its
     derivative along w: one kernel call gives every entry."""
 
@@ -87,21 +95,26 @@ class Slice:
         theta, lam = x[:, :6], x[:, 6]
         P = self.p[None, :] + lam[:, None] * self.w[None, :]
         F, dF, dFl = kernels.call(
-            "ik_system6", pairs_of(law(pb, theta)), pairs_of(P), pairs_of(np.broadcast_to(self.w, P.shape)), pb.dh
+            "ik_system6",
+            pairs_of(law(pb, theta)),
+            pairs_of(P),
+            pairs_of(np.broadcast_to(self.w, P.shape)),
+            pb.dh,
+            pb.turning,
         )
-        z, k = coordinates(pb, theta)
+        z, zw, dz, dzw = coordinates(pb, theta)
         a = self.ell[0][None, :] + s[:, None] * self.dell[0][None, :]
         b = self.ell[1][None, :] + s[:, None] * self.dell[1][None, :]
-        ell = np.sum(a * z + b / z, axis=1)
+        ell = np.sum(a * z + b * zw, axis=1)
         mu = lam if self.times_lambda else np.ones_like(lam)
         H = np.concatenate([complex_of(F), ((ell - 1) * mu + self.t0 + s * self.dt)[:, None]], axis=1)
         J = np.zeros((len(x), 7, 7), complex)
         J[:, :6, :6] = complex_of(dF)
         J[:, :6, 6] = complex_of(dFl)
-        J[:, 6, :6] = 1j * k * (a * z - b / z) * mu[:, None]
+        J[:, 6, :6] = (a * dz + b * dzw) * mu[:, None]
         J[:, 6, 6] = (ell - 1) if self.times_lambda else 0.0
         Hs = np.zeros_like(H)
-        Hs[:, 6] = np.sum(self.dell[0] * z + self.dell[1] / z, axis=1) * mu + self.dt
+        Hs[:, 6] = np.sum(self.dell[0] * z + self.dell[1] * zw, axis=1) * mu + self.dt
         return H, J, Hs
 
     def track_once(self, gamma: complex, start: np.ndarray, engine: str | None = None):
@@ -112,7 +125,7 @@ class Slice:
         if native is None:
             if engine == "c":
                 raise RuntimeError("engine: the compiled C kernels are not installed")
-            return track_system(self, gamma, start, 6)
+            return track_system(self, gamma, start, self.problem)
         pb = self.problem
         args = (
             pb.kind,
@@ -178,9 +191,9 @@ def witness_points(problem: Problem, start: StartSystem, rng, progress=None, kno
         else:
             raise RuntimeError("trace: no point of the pose line's curve could be reached")
         theta = end[0]
-        z, _ = coordinates(problem, theta)
+        z, zw, _, _ = coordinates(problem, theta)
         ell = _crandn(rng, 2, 6)
-        ell /= np.sum(ell[0] * z + ell[1] / z)
+        ell /= np.sum(ell[0] * z + ell[1] * zw)
         points = [np.concatenate([theta, [lam]])]
     for x in points:
         index.add(x[:6])
@@ -246,14 +259,18 @@ def _quat(a, b) -> np.ndarray:
 def exact_system(problem: Problem, theta, P) -> list:
     """F(θ; P) (6 flint.acb) of ik_system6 at FLINT's working precision: the end frame's origin
     from the product of the 4×4 DH matrices Rz(θ + φ)·Tz(c + d(θ))·Tx(a)·Rx(α) minus t, and the
-    vector part of q̄ ⊗ x with x the product of the quaternions of Rz(θ + φ) and Rx(α)."""
+    vector part of q̄ ⊗ x with x the product of the quaternions of Rz(θ + φ) and Rx(α) (a P-pair:
+    θ = 0 and d its slide)."""
     zero, one = flint.acb(0), flint.acb(1)
     T = [[one if r == c else zero for c in range(4)] for r in range(3)]
     x: tuple[Any, ...] | np.ndarray = (one, zero, zero, zero)
     for i in range(6):
         a, alpha, c, phi = (flint.acb(float(v)) for v in problem.dh[i])
-        th = theta[i] + phi
-        d = flint.acb(float(problem.pair[i, 0])) * (theta[i] / 2).cos() if problem.kind[i] else zero
+        slide = bool(problem.slides[i])
+        th = phi if slide else theta[i] + phi
+        d = zero if problem.kind[i] == R_PAIR else flint.acb(float(problem.pair[i, 0])) * (theta[i] / 2).cos()
+        if slide:
+            d = theta[i]
         ct, st, ca, sa = th.cos(), th.sin(), alpha.cos(), alpha.sin()
         A = [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [zero, sa, ca, c + d]]
         T = [
@@ -271,7 +288,15 @@ def exact_system(problem: Problem, theta, P) -> list:
 
 
 def _exact_coordinates(problem, theta) -> list:
-    return [(flint.acb(0, 1 if problem.kind[j] == 0 else 0.5) * theta[j]).exp() for j in range(6)]
+    """The coordinates (z, w) of `coordinates` per joint, as flint.acb pairs."""
+    out = []
+    for j in range(6):
+        if problem.slides[j]:
+            out.append((theta[j], flint.acb(1)))
+        else:
+            z = (flint.acb(0, 1 if problem.kind[j] == R_PAIR else 0.5) * theta[j]).exp()
+            out.append((z, 1 / z))
+    return out
 
 
 def _refine(sl: Slice, X: np.ndarray) -> list[list[Any] | None]:
@@ -302,7 +327,7 @@ def _refine(sl: Slice, X: np.ndarray) -> list[list[Any] | None]:
                     lam = xm[6]
                     F = exact_system(pb, xm[:6], [p[k] + lam * w[k] for k in range(7)])
                     z = _exact_coordinates(pb, xm[:6])
-                    ell = sum((a[0][j] * z[j] + a[1][j] / z[j] for j in range(6)), flint.acb(0))
+                    ell = sum((a[0][j] * z[j][0] + a[1][j] * z[j][1] for j in range(6)), flint.acb(0))
                     G = np.array([complex(v.mid()) for v in F + [(ell - 1) * lam + t]])
                     _, J, _ = sl(np.array([[complex(v.mid()) for v in xm]]), one[:1])
                     with np.errstate(all="ignore"):
@@ -320,21 +345,21 @@ def _refine(sl: Slice, X: np.ndarray) -> list[list[Any] | None]:
 
 
 def _trace_sum(problem: Problem, points: list) -> list:
-    """Σ (z, 1/z, λ) (13 flint.acb) over refined points (7 flint.acb each), at DIGITS digits."""
+    """Σ (z, w, λ) (13 flint.acb) over refined points (7 flint.acb each), at DIGITS digits."""
     with flint.ctx.workdps(DIGITS):
         total = [flint.acb(0)] * 13
         for xm in points:
             z = _exact_coordinates(problem, xm[:6])
             for j in range(6):
-                total[j] += z[j]
-                total[6 + j] += 1 / z[j]
+                total[j] += z[j][0]
+                total[6 + j] += z[j][1]
             total[12] += xm[6]
     return total
 
 
 def _sizes(problem, X: np.ndarray) -> np.ndarray:
-    z, _ = coordinates(problem, X[:, :6])
-    return np.concatenate([np.abs(z), np.abs(1 / z), np.abs(X[:, 6:7])], axis=1).sum(0)
+    z, zw, _, _ = coordinates(problem, X[:, :6])
+    return np.concatenate([np.abs(z), np.abs(zw), np.abs(X[:, 6:7])], axis=1).sum(0)
 
 
 @dataclass

@@ -14,7 +14,7 @@ import numpy as np
 
 from ... import kernels
 from ...kernels import native_in_use
-from .problem import Problem, complex_of, law, pairs_of, system
+from .problem import Problem, complex_of, far_of, law, pairs_of, system
 
 RETRIES = 10  # new γ for what paths that failed or jumped left undone (per pose: rounds, see solve)
 OK, SINGULAR, FAILED, DIVERGED, TOO_LONG = range(5)
@@ -178,7 +178,12 @@ def _batched(problem: Problem, theta, s, p0, dp):
     lw = law(problem, theta)
     target = p0[None, :] + s[:, None] * dp[None, :]
     F, dF, dFs = kernels.call(
-        f"ik_system{problem.n}", pairs_of(lw), pairs_of(target), pairs_of(np.broadcast_to(dp, target.shape)), problem.dh
+        f"ik_system{problem.n}",
+        pairs_of(lw),
+        pairs_of(target),
+        pairs_of(np.broadcast_to(dp, target.shape)),
+        problem.dh,
+        problem.turning,
     )
     return complex_of(F), complex_of(dF), complex_of(dFs)
 
@@ -203,7 +208,7 @@ def track_numpy(problem: Problem, p0, p1, gamma, start: np.ndarray, endgame: boo
     the one before), step control, endgame (`endgame`: the paths of one pose) and endpoint test.
     The fallback without the C kernels, and an independent check of the C tracker."""
     p0, dp = np.asarray(p0, complex), np.asarray(p1, complex) - np.asarray(p0, complex)
-    return track_system(lambda x, s: _batched(problem, x, s, p0, dp), gamma, start, problem.n, endgame)
+    return track_system(lambda x, s: _batched(problem, x, s, p0, dp), gamma, start, problem, endgame)
 
 
 # The endgame of apair_ik_track.c (to_infinity): from which τ it watches, how much a path to
@@ -213,12 +218,16 @@ ENDGAME = (0.5, 0.8, 0.1)
 
 class _Endgame:
     """to_infinity of apair_ik_track.c for all paths at once: each path's last sample (L = log(1 −
-    τ), the angles) and the slope over the interval that ended there."""
+    τ), the angles, a P-pair's slide x as the angle i log x continued from sample to sample, and x)
+    and the slope over the interval that ended there."""
 
-    def __init__(self, k: int, angles: int) -> None:
+    def __init__(self, k: int, problem: Problem) -> None:
+        angles = problem.n
+        self.problem = problem
         self.samples = np.zeros(k, int)
         self.L = np.zeros(k)
         self.v = np.zeros((k, angles), complex)
+        self.x = np.zeros((k, angles), complex)
         self.beta = np.zeros((k, angles), complex)
 
     def diverged(self, rows: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
@@ -228,14 +237,21 @@ class _Endgame:
         with np.errstate(divide="ignore"):
             L = np.log1p(-tau)
         take = (tau >= start) & (tau < 1) & ((self.samples[rows] == 0) | (self.L[rows] - L >= math.log(2)))
-        rows, v, L = rows[take], v[take], L[take]
+        rows, x, L = rows[take], v[take], L[take]
         out = np.zeros(len(take), bool)
         had = self.samples[rows] > 0
+        slides = self.problem.slides
+        v = x.copy()
+        with np.errstate(all="ignore"):
+            if slides.any():
+                logs = np.where(had[:, None], self.v[rows] + 1j * np.log(x / self.x[rows]), 1j * np.log(x))
+                v[:, slides] = logs[:, slides]
+            joint_far = np.where(slides, np.maximum(0.0, np.log(np.abs(x))), np.abs(x.imag))
         beta = np.zeros_like(v)
         beta[had] = (v[had] - self.v[rows[had]]) / (L[had] - self.L[rows[had]])[:, None]
-        j = np.argmax(np.abs(v.imag), axis=1)
+        j = np.argmax(joint_far, axis=1)
         at = np.arange(len(rows))
-        far = np.abs(v.imag)[at, j]
+        far = joint_far[at, j]
         b, b0 = beta[at, j], self.beta[rows, j]
         sign = np.where(v[at, j].imag > 0, -1.0, 1.0)
         size = np.abs(b)
@@ -249,18 +265,19 @@ class _Endgame:
             & (far > size * math.log(2) * ratio / (1 - ratio))
         )
         self.beta[rows[had]] = beta[had]
-        self.L[rows], self.v[rows] = L, v
+        self.L[rows], self.v[rows], self.x[rows] = L, v, x
         self.samples[rows] += 1
         out[np.flatnonzero(take)] = verdict
         return out
 
 
-def track_system(evaluate, gamma, start: np.ndarray, angles: int, endgame: bool = False):
+def track_system(evaluate, gamma, start: np.ndarray, problem: Problem, endgame: bool = False):
     """track_numpy's tracker for any square system H(x; s) = 0 from s = 0 to 1 along the γ arc:
     evaluate(x (k, m), s (k,)) gives H (k, m), dH/dx (k, m, m) and ∂H/∂s (k, m); the first
-    `angles` columns of x are complex joint angles (the divergence and far-out tests look at
-    them; apair.ik.homotopy.trace tracks an extra column that is not an angle). endgame: end the
-    paths found going to infinity (_Endgame). Returns (end, status, steps, cond)."""
+    problem.n columns of x are the problem's complex joint variables (the divergence and far-out
+    tests look at them, `far_of`; apair.ik.homotopy.trace tracks an extra column that is no joint).
+    endgame: end the paths found going to infinity (_Endgame). Returns (end, status, steps, cond)."""
+    angles = problem.n
     o = TRACK
     g = complex(gamma)
     k = len(start)
@@ -269,7 +286,7 @@ def track_system(evaluate, gamma, start: np.ndarray, angles: int, endgame: bool 
     good, steps = np.zeros(k, int), np.zeros(k, int)
     status = np.full(k, -1)
     k1s, have = np.zeros_like(v), np.zeros(k, bool)  # dv/dτ at (v, τ), as the C tracker keeps it
-    watch = _Endgame(k, angles) if endgame else None
+    watch = _Endgame(k, problem) if endgame else None
 
     def s_of(t):
         den = 1 + (g - 1) * t
@@ -299,7 +316,7 @@ def track_system(evaluate, gamma, start: np.ndarray, angles: int, endgame: bool 
             conv = dn <= tol * (1 + np.abs(x[idx]).max(1))
             ok[idx[conv]] = True
             stall = (it > 0) & (dn > 0.5 * prev[idx]) & ~conv
-            far = np.abs(x[idx, :angles].imag).max(1)
+            far = far_of(problem, x[idx, :angles])
             ok[idx[stall & (far > 4.0) & (dn <= 1e3 * tol * (1 + np.abs(x[idx]).max(1)))]] = True
             live[idx[conv | stall]] = False
             prev[idx] = dn
@@ -337,7 +354,7 @@ def track_system(evaluate, gamma, start: np.ndarray, angles: int, endgame: bool 
             grow = good[acc] >= 2
             h[acc[grow]] = np.minimum(2 * h[acc[grow]], o["max_step"])
             good[acc[grow]] = 0
-            status[acc[np.abs(v[acc, :angles].imag).max(1) > o["divergence"]]] = DIVERGED
+            status[acc[far_of(problem, v[acc, :angles]) > o["divergence"]]] = DIVERGED
             if watch is not None:
                 status[acc[watch.diverged(acc, v[acc, :angles], tau[acc])]] = DIVERGED
             h[rej] *= 0.5
@@ -360,6 +377,6 @@ def track_system(evaluate, gamma, start: np.ndarray, angles: int, endgame: bool 
             _, J, _ = evaluate(x, s)
             cond[fin] = np.linalg.cond(J, 1)
             conv = prev <= o["path_tol"] * (1 + np.abs(x).max(1))
-            out = ~np.all(np.isfinite(x), axis=1) | (np.abs(x[:, :angles].imag).max(1) > o["divergence"])
+            out = ~np.all(np.isfinite(x), axis=1) | (far_of(problem, x[:, :angles]) > o["divergence"])
             status[fin] = np.where(out, DIVERGED, np.where(conv & (cond[fin] <= o["singular_cond"]), OK, SINGULAR))
     return v, status.astype(np.int32), steps.astype(np.int32), cond
