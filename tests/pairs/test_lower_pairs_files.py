@@ -100,11 +100,17 @@ def test_lower_pairs_have_no_legs_and_refuse_what_needs_them():
     assert APair.prismatic().turning == 0.0 and APair.helical(0.01).turning == 1.0
 
 
-def test_all_solutions_ik_refuses_and_ik_local_solves():
+def test_all_solutions_ik_refuses_the_helical_pair_and_ik_local_solves():
+    """The SCARA of the file: all-solutions ik refuses its helical pair (one line naming it); with a
+    revolute last joint it finds the pose's joint values (the slide in m) among its certified
+    solutions; ik_local solves the helical one from a nearby seed."""
     chain = apair.io.loads(SCARA)
-    with pytest.raises(ValueError, match=r"^pairs\[2\]: all-solutions inverse kinematics of chains with prismatic"):
-        chain.ik(chain.fk([0.1, 0.2, 0.1, 0.3]))
     q = np.array([0.5, -0.7, 0.12, 1.3])
+    with pytest.raises(ValueError, match=r"^pairs\[3\]: a helical pair's d = pitch\*theta is not algebraic"):
+        chain.ik(chain.fk(q))
+    revolute = apair.io.loads(SCARA.replace('pair = "helical"\npitch = 0.002', 'pair = "revolute"'))
+    sol = revolute.ik(revolute.fk(q), full=True)
+    assert sol.certified and len(sol.q) == 2 and np.abs(sol.q - q).max(axis=1).min() < 1e-9
     sol = chain.ik_local(chain.fk(q), q + [0.05, -0.05, 0.02, 0.05])
     assert sol.converged and np.abs(sol.q - q).max() < 1e-9
 
