@@ -1,10 +1,13 @@
-"""Derivatives of the chain dynamics in the joint state, n = 1..7 (issue 39): forward-mode
+"""Derivatives of the chain dynamics in the joint state, n = 1..7 (issue 39): reverse-mode
 differentiation of the recorded steps of derivations/chain_dynamics.py, never finite differences.
 
-- `inverse_dynamics_derivatives{n}`: ∂τ/∂θ and ∂τ/∂θ' of τ = RNEA(θ, θ', θ''), each column one
-  directional derivative (derivations/autodiff.py) of the recursion's steps: along θ_k through the
-  law values (`Assembly.seeds(k)`: cos(θ/2), sin(θ/2), d, d', and d'' → d'''), along θ'_k by the
-  velocity symbol itself. (∂τ/∂θ'' is M, the mass_matrix kernel's.)
+- `inverse_dynamics_derivatives{n}`: ∂τ/∂θ and ∂τ/∂θ' of τ = RNEA(θ, θ', θ''), each row one
+  gradient (derivations/autodiff.py `gradient`: one backward pass over the recursion's steps).
+  Row i is ∇τ_i: the adjoints of the velocity symbols are ∂τ_i/∂θ', those of the law values give
+  ∂τ_i/∂θ_k through the law (`Assembly.seeds(k)`: cos(θ/2), sin(θ/2), d, d', and d'' → d''').
+  n backward passes give both matrices, where forward mode took 2n passes (one per column, each
+  re-running the recursion from link k and the whole backward pass): after CSE, 15818 → 13129
+  operations for n = 6 and 21733 → 18058 for n = 7. (∂τ/∂θ'' is M, the mass_matrix kernel's.)
 - `forward_dynamics_derivatives{n}`: with θ'' = FD(θ, θ', τ) solving M θ'' = τ − b,
   ∂FD/∂θ = −M⁻¹ ∂ID/∂θ and ∂FD/∂θ' = −M⁻¹ ∂ID/∂θ' at (θ, θ', θ''), and ∂FD/∂τ = M⁻¹. M and the
   bias b = ID(θ, θ', 0) come from the mass_matrix and inverse_dynamics kernels (`Call`), M⁻¹ from
@@ -20,7 +23,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from .autodiff import directional
+from .autodiff import gradient
 from .chain_dynamics import Assembly, rnea, specs_for
 from .chain_kinematics import MAX_N, _Recorder
 from .spec import Arg, Call, KernelSpec
@@ -60,22 +63,35 @@ def angle_seeds(asm: Assembly, k: int, dddd: sp.Symbol) -> dict:
 
 def rnea_derivatives(asm: Assembly, qdd, dddd, prefix: str):
     """(steps, ∂τ/∂θ, ∂τ/∂θ') of τ = RNEA(θ, θ', qdd) with gravity (n x n matrices, [i, k] =
-    ∂τ_i/∂x_k); `qdd` are symbols held fixed (inputs, or steps computed before these)."""
+    ∂τ_i/∂x_k); `qdd` are symbols held fixed (inputs, or steps computed before these). Row i is
+    one reverse pass: the gradient of τ_i in the law values (then through the law to θ_k) and in
+    the velocities, over the steps that depend on them."""
     n = asm.n
     qd = [j["qd"] for j in asm.J]
     id_steps, tau = rnea(asm, qd, qdd, gravity=True, prefix=f"{prefix}id_")
     steps = needed(asm.rec.steps + id_steps, tau)
+    live = active(steps, set(asm.args["law"].symbols) | set(qd))
     out = list(steps)
     dq, dqd = sp.zeros(n, n), sp.zeros(n, n)
-    for k in range(1, n + 1):
-        new, col = directional(steps, tau, angle_seeds(asm, k, dddd[k - 1]), f"{prefix}q{k}_")
+    seeds = [angle_seeds(asm, k, dddd[k - 1]) for k in range(1, n + 1)]
+    for i in range(n):
+        new, grads = gradient(live, tau[i], f"{prefix}r{i + 1}_")
         out += new
-        dq[:, k - 1] = sp.Matrix(col)
-    for k in range(1, n + 1):
-        new, col = directional(steps, tau, {qd[k - 1]: 1}, f"{prefix}v{k}_")
-        out += new
-        dqd[:, k - 1] = sp.Matrix(col)
+        for k in range(n):
+            dq[i, k] = sum((grads.get(s, 0) * v for s, v in seeds[k].items()), sp.S(0))
+            dqd[i, k] = grads.get(qd[k], 0)
     return out, dq, dqd
+
+
+def active(steps, inputs) -> list:
+    """The steps that depend on `inputs`: only they need adjoints (the others, design invariants
+    and the held accelerations, are constants of the differentiation)."""
+    live, keep = set(inputs), []
+    for sym, e in steps:
+        if e.free_symbols & live:
+            keep.append((sym, e))
+            live.add(sym)
+    return keep
 
 
 def cholesky_inverse(M: sp.Matrix, prefix: str):

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: fbb0f6529330ba95
+Content hash: d015a4275e9a1fb8
 """

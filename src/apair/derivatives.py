@@ -1,6 +1,6 @@
 """Derivatives of a chain's dynamics in its state (AChain.inverse_dynamics_derivatives,
 AChain.forward_dynamics_derivatives), from the generated kernels of
-derivations/chain_dynamics_derivatives.py: forward-mode derivatives of the recursions' steps,
+derivations/chain_dynamics_derivatives.py: reverse-mode derivatives of the recursions' steps,
 exact up to rounding (no finite differences); and the Jacobian's time derivative
 (AChain.jacobian_dot, the kernels jacobian_dot<n> of derivations/chain_kinematics.py).
 
