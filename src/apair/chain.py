@@ -23,6 +23,7 @@ from . import derivatives as D
 from .files import write_text
 from .frames import EYE4, FramedLocal, check_frame, inverse
 from .hold import held_ik
+from .ik.families import Classification, classify
 from .kernels import call, native_chain
 from .link import Link
 from .pair import APair
@@ -601,19 +602,16 @@ class AChain:
     ) -> NDArray[np.float64] | Solution:
         """All real joint vectors q (k, n) with fk(q) = T, each verified (largest entry of
         |fk(q) − T| ≤ tol); (0, n) when T is out of reach. T: a 4×4 transform or a Study point,
-        the tool's pose in the world (with base or tool frames: solved for frame n's pose
-        base⁻¹·T·tool⁻¹ in frame 0, where the check and `error` are measured).
-        within_limits=True keeps only the solutions inside `limits` (no collisions).
+        the tool's pose in the world (with frames: solved for frame n's pose base⁻¹·T·tool⁻¹ in frame
+        0, where `error` is measured). within_limits=True keeps the solutions inside `limits`.
 
         Chains of 1 to 6 sinusoidal A-, R- or P-pairs (7 with `fix`; P-pairs by the homotopy, any n,
         their slides in m, any real value). Otherwise n ≤ 4 by kinematic mapping (see
         apair.ik.elimination4): the left half's constraint variety on the right part's image,
         eliminated to eigenvalue and univariate problems. 5 and 6 R-pairs by the 6R elimination
         (apair.ik.elimination6r) where it certifies its 16 solutions, chains with one A-pair by
-        theirs (apair.ik.elimination1a5r); otherwise n = 5, 6 by parameter homotopy (see
-        apair.ik.homotopy) from the design's start system (`prepare_ik`, cached on disk), every
-        complex solution tracked to T.
-        Angles in (−2π, 2π] for A-pairs, (−π, π] for R-pairs.
+        theirs (apair.ik.elimination1a5r); otherwise by parameter homotopy (apair.ik.homotopy) from the
+        design's start system (`prepare_ik`, cached). Angles in (−2π, 2π] for A-pairs, (−π, π] for R.
         fix={k: value, ...} (joints from 1): those joints held at those values [rad], the rest solved
         (needed for 7 joints, whose poses have a continuum of solutions: ik_local gives the one
         nearest a seed). The held joint's transform is folded into the base (k = 1), the tool
@@ -626,9 +624,8 @@ class AChain:
         may be incomplete: a local search supplied the solutions (n ≤ 4), or the start set or the
         paths did not account for every solution (n = 5, 6)), `method` ("elimination", "homotopy",
         "local search" or "reach bound") and `note` (why it is not certified, or how it was at a
-        singular pose). It costs about twice the plain answer for n ≤ 4 and nothing more for n = 5, 6,
-        but at a pose beyond the reach bound, which the plain answer settles without solving and the
-        full one still solves to count the complex solutions.
+        singular pose) and `family` (the chain's kinematic family). It costs twice the plain answer
+        for n ≤ 4, nothing more for n = 5, 6 (beyond the reach bound it still solves, to count).
         """
         from .ik import Solver
 
@@ -658,6 +655,10 @@ class AChain:
             sol = dataclasses.replace(sol, q=sol.q[inside], error=sol.error[inside])
             inside = inside[inside]
         return dataclasses.replace(sol, inside=inside) if full else sol.q
+
+    def kinematic_family(self) -> Classification:
+        """The chain's kinematic family and its R twin's (which axes are parallel or meet; EAIK's families): apair.ik.families."""
+        return classify(self)
 
     def prepare_ik(
         self, progress: Callable[[int, int], object] | None = None, refresh: bool = False, trace: bool = False

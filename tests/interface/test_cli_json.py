@@ -192,7 +192,7 @@ def test_ik_prepare_json_matches_api(capsys, tmp_path):
     assert doc["seconds"] == start.seconds and doc["units"]["seconds"] == "s"
 
 
-def test_ik_prepare_text_unchanged(capsys, tmp_path):
+def test_ik_prepare_text(capsys, tmp_path):
     path = arm_toml(tmp_path)
     code, out, _ = run(capsys, "ik-prepare", path, "--quiet")
     assert code == 0
@@ -200,6 +200,7 @@ def test_ik_prepare_text_unchanged(capsys, tmp_path):
     assert out == (
         f"arm: start system of 16 complex solutions, certified complete: {start.how}; runs found {start.runs} "
         f"in {start.loops} loops ({start.seconds:.1f} s to compute; cached)\n"
+        f"kinematic family: {apair.load(path).kinematic_family().describe()}\n"
     )
 
 

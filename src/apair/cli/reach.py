@@ -17,6 +17,7 @@ from .output import add_json, emit, text_numbers
 
 if TYPE_CHECKING:
     from ..ik import Solution
+    from ..ik.families import Classification
     from ..ik.local import Nearest
 
 Sub = Any  # argparse's subparsers action (a private class)
@@ -53,8 +54,9 @@ def _cmd_ik(args: argparse.Namespace) -> int:
             "" if sol.certified else f"; not certified complete: {sol.note}" if sol.note else "; not certified complete"
         )
         count = f" of {sol.complex_count} complex" if sol.complex_count is not None else ""
+        family = f"; family {sol.family}" if sol.family not in ("", "unclassified") else ""
         print(
-            f"{chain.name}: {len(sol.q)} real solution(s){count}, by {sol.method}{complete}; angles in rad"
+            f"{chain.name}: {len(sol.q)} real solution(s){count}, by {sol.method}{complete}{family}; angles in rad"
             f"{' and deg' if args.deg else ''}"
         )
         for q, e, ok in zip(sol.q, sol.error, inside):
@@ -86,6 +88,7 @@ def _ik_document(
         "method": sol.method,
         "certified": sol.certified,
         "note": sol.note,
+        "family": sol.family,
     }
     if nearest is not None:
         doc["nearest"] = {
@@ -115,6 +118,7 @@ def _cmd_ik_prepare(args: argparse.Namespace) -> int:
 
         progress = show
 
+    family = chain.kinematic_family()
     start = chain.prepare_ik(progress=progress, refresh=args.refresh, trace=args.trace)
     if progress:
         print(file=sys.stderr)
@@ -132,6 +136,7 @@ def _cmd_ik_prepare(args: argparse.Namespace) -> int:
                 "runs": start.runs,
                 "loops": start.loops,
                 "seconds": start.seconds,
+                "family": _family_document(family),
             }
         )
         return 0
@@ -142,7 +147,29 @@ def _cmd_ik_prepare(args: argparse.Namespace) -> int:
         f"{chain.name}: start system of {start.count} complex solutions, {state}; runs found {start.runs} "
         f"in {start.loops} loops ({start.seconds:.1f} s to compute; cached)"
     )
+    print(f"kinematic family: {family.describe()}")
     return 0
+
+
+def _family_document(family: Classification) -> dict[str, Any]:
+    """The chain's kinematic family for --json: its key, conditions, EAIK's name, its R twin's and
+    the joints whose slide breaks the twin's, and the axes' facts (joints from 1)."""
+    f, twin = family.family, family.twin
+    facts = family.facts
+    pairs = lambda flags: [[k + 1, k + 2] for k, x in enumerate(flags) if x]
+    return {
+        "key": family.key,
+        "conditions": f.conditions if f else "",
+        "eaik": f.eaik if f else "",
+        "reversed": f.reversed if f else False,
+        "twin": twin.key if twin else "unclassified",
+        "broken_by": list(family.broken_by),
+        "parallel": pairs(facts.parallel),
+        "meeting": pairs(facts.meeting),
+        "spherical": [[k + 1, k + 2, k + 3] for k, x in enumerate(facts.spherical) if x],
+        "sliding": family.sliding_joints(),
+        "description": family.describe(),
+    }
 
 
 def _cmd_workspace(args: argparse.Namespace) -> int:

@@ -8,6 +8,7 @@ solution of a pose, each verified, by the cheapest exact method that fits the ch
   one A-pair, by the Raghavan-Roth elimination;
 - `homotopy`: every complex solution of 5 and 6 joints by parameter homotopy from the design's
   start system (tracker, monodromy, start sets, the trace test, the patterns' counts);
+- `families`: the chain's kinematic family (which axes are parallel or meet; EAIK's families);
 - `poses`: poses in and the verification of candidates; `local`: Levenberg-Marquardt searches
   (the fallback, the nearest reachable pose `distance`, and `ik_local` in C).
 

@@ -17,6 +17,7 @@ scaled by s. A pose beyond the chain's reach bound is answered without any elimi
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
@@ -26,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import elimination1a5r, elimination6r, homotopy
 from .elimination4 import CAND_TOL, Elimination
+from .families import classify
 from .local import local_search, on_continuum
 from .pencil import SEED, Degenerate
 from .poses import (
@@ -56,7 +58,10 @@ class Solution:
     (n ≤ 4), or a start set or paths that do not account for every solution (n = 5, 6); method:
     how the set was found ("reach bound": the pose's position lies beyond Σ |a| + |c| + 2h from
     the base, so no joint vector reaches it); note: why it is not certified, or how it was where
-    the method alone did not (a singular pose certified by a pose moved by 1e-6), else empty."""
+    the method alone did not (a singular pose certified by a pose moved by 1e-6), else empty;
+    family: the key of the chain's kinematic family (`apair.ik.families`: which axes are parallel or
+    meet, "general" where no subproblem decomposition is known). The family is recognised, but every
+    family is solved by the general methods above (`method` says which)."""
 
     q: NDArray[np.float64]
     error: NDArray[np.float64]
@@ -66,6 +71,7 @@ class Solution:
     inside: NDArray[np.bool_] | None = None  # (k,) within the chain's joint limits (set by AChain.ik)
     method: str = "elimination"  # or "homotopy" (n = 5, 6), "local search" (the fallback), "reach bound"
     note: str = ""  # why the set is not certified, or how it was where not by the method alone
+    family: str = ""  # the chain's kinematic family (apair.ik.families; "unclassified" for n != 6)
 
 
 FAR = 1e6  # beyond FAR times the reach bound a pose is answered by the bound even when complex
@@ -129,6 +135,7 @@ class Solver:
                     "tangent, so all-solutions inverse kinematics does not apply; use ik_local(T, q0)"
                 )
         self.chain = chain
+        self.family = classify(chain)
         self.scale = length_scale(chain)
         self.slides = np.array([p.kind == "prismatic" for p in chain.pairs])
         # the reach bound counts a P-pair's slide within its limits; its solutions are any real d
@@ -146,6 +153,9 @@ class Solver:
     def solve(self, T: ArrayLike, tol: float = 1e-9, count_complex: bool = False) -> Solution:
         """All real solutions at T, verified to tol (rotation entries; translations in units of
         the chain's length scale; a float32 pose to its own precision at least, `Pose.floor`)."""
+        return dataclasses.replace(self._solve(T, tol, count_complex), family=self.family.key)
+
+    def _solve(self, T: ArrayLike, tol: float, count_complex: bool) -> Solution:
         pose = pose_of(T)
         tol = max(tol, pose.floor)
         if self._beyond_reach(pose.matrix, count_complex):
