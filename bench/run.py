@@ -47,8 +47,9 @@ import tempfile
 import time
 from pathlib import Path
 
+import ik_closed  # bench/ is sys.path[0] when run as a script
 import numpy as np
-from design_bench import design_targets, time_design  # bench/ is sys.path[0] when run as a script
+from design_bench import design_targets, time_design
 
 import apair
 from apair import kernels
@@ -1253,6 +1254,11 @@ def main(argv=None) -> int:
         action="store_true",
         help="only the derivatives of the dynamics from Python, one state per call, against Pinocchio's binding",
     )
+    ap.add_argument(
+        "--ik-closed-only",
+        action="store_true",
+        help="only the closed-form IK of arms with a spherical wrist, against EAIK and IK-Geo",
+    )
     ap.add_argument("--out", type=Path, default=ROOT / "bench" / "results.json")
     args = ap.parse_args(argv)
     try:
@@ -1294,6 +1300,17 @@ def main(argv=None) -> int:
         args.out.write_text(json.dumps(results, indent=1, default=_plain) + "\n")
         print(f"written to {args.out}")
         return 0
+    if args.ik_closed_only or not (args.derivatives_only or args.panda_only or args.native_only):
+        print("closed-form IK, spherical wrists (apair, EAIK, IK-Geo; same poses):", flush=True)
+        results["ik_closed"] = ik_closed.section(args.quick)
+        results["ik_closed_targets"] = ik_closed.targets(results["ik_closed"])
+        print(f"targets (closed-form IK; load average {results['ik_closed']['load_average']:.2f}):")
+        for t in results["ik_closed_targets"]:
+            print(f"  [{'met' if t['met'] else 'MISSED'}] {t['target']}: {t['measured']:.3g}")
+        if args.ik_closed_only:
+            args.out.write_text(json.dumps(results, indent=1, default=_plain) + "\n")
+            print(f"written to {args.out}")
+            return 0
     if args.derivatives_only:
         results["derivatives_single"] = derivatives_single(args.quick, pin_ok)
         results["derivatives_single_targets"] = derivatives_single_targets(results["derivatives_single"])

@@ -33,6 +33,7 @@ DERIVATIONS = (
     "chain_ik",
     "chain_ik6r",
     "chain_ik1a5r",
+    "chain_ik_wrist",
 )
 # The derivations whose kernels a derivation's kernels call (`Call`): --only runs them too.
 NEEDS = {"chain_dynamics_derivatives": ("chain_dynamics",)}
@@ -58,6 +59,7 @@ COST = {
     ("chain_ik1a5r", 1): 12,
     ("chain_ik1a5r", 2): 12,
     ("chain_ik1a5r", 3): 12,
+    ("chain_ik_wrist", None): 2,
 }
 
 

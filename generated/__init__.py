@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: d015a4275e9a1fb8
+Content hash: 79a0155b9108e372
 """

@@ -622,10 +622,10 @@ class AChain:
         (the solutions over the complex numbers), `inside` (whether each solution is within
         `limits`), `certified` (the set is proven complete, an empty one included; False where it
         may be incomplete: a local search supplied the solutions (n ≤ 4), or the start set or the
-        paths did not account for every solution (n = 5, 6)), `method` ("elimination", "homotopy",
-        "local search" or "reach bound") and `note` (why it is not certified, or how it was at a
-        singular pose) and `family` (the chain's kinematic family). It costs twice the plain answer
-        for n ≤ 4, nothing more for n = 5, 6 (beyond the reach bound it still solves, to count).
+        paths did not account for every solution (n = 5, 6)), `method` ("closed form", "elimination",
+        "homotopy", "local search" or "reach bound"), `note` (why it is not certified, how it was at a
+        singular pose, or a continuum's member given) and `family` (the chain's kinematic family).
+        It costs twice the plain answer for n ≤ 4, nothing more for n = 5, 6.
         """
         from .ik import Solver
 

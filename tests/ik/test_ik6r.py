@@ -189,7 +189,8 @@ def test_special_designs_stay_complete(name):
             certified += 1
             assert same_sets(homotopy.canonical(problem, theta), homotopy.solve(problem, start, T).theta), name
         sol = chain.ik(T, full=True)
-        assert sol.method == ("elimination" if theta is not None else "homotopy")
+        wrist = chain.kinematic_family().key.startswith("spherical-")
+        assert sol.method == ("closed form" if wrist else "elimination" if theta is not None else "homotopy")
         assert contains(sol.q, q, 1e-6), (name, q, sol.q)
         assert np.abs(chain.fk(sol.q) - T).max() <= 1e-9
     if generic:
@@ -208,11 +209,20 @@ def test_singular_pose_falls_back_to_the_homotopy():
 
 
 def test_a_wrist_singularity_is_refused():
-    """PUMA-like at θ5 = 0: axes 4 and 6 in line, a curve of solutions (θ4 + θ6 fixed)."""
+    """PUMA-like at θ5 = 0: axes 4 and 6 in line, a curve of solutions (θ4 + θ6 fixed): the general
+    solver refuses it; the closed form gives one member of each continuum and says so
+    (tests/ik/test_ik_wrist.py)."""
+    from apair.ik.solver import Solver
+
     a, alpha, c, _ = SPECIAL["PUMA-like (spherical wrist: 8 solutions)"]
     chain = arm(a, alpha, c)
+    general = Solver(chain)
+    general._wrist = None
+    T = chain.fk(np.array([0.3, -0.5, 0.4, 0.7, 0.0, 0.2]))
     with pytest.raises(ValueError, match="not isolated"):
-        chain.ik(chain.fk(np.array([0.3, -0.5, 0.4, 0.7, 0.0, 0.2])))
+        general.solve(T)
+    sol = chain.ik(T, full=True)
+    assert sol.method == "closed form" and "axes 4 and 6 in line" in sol.note
 
 
 def test_five_r_chains_through_the_virtual_joint():
@@ -244,7 +254,7 @@ def test_cli_names_the_route(tmp_path, capsys):
     q = np.array([0.3, -0.5, 0.8, 1.1, -0.4, 0.2])
     assert cli(["ik", str(path), *[repr(float(x)) for x in chain.fk(q).ravel()]]) == 0
     out = capsys.readouterr().out
-    assert "of 16 complex, by elimination; angles in rad" in out
+    assert "of 16 complex, by elimination; family general; angles in rad" in out
 
 
 @pytest.mark.parametrize(

@@ -11,7 +11,6 @@ where its lengths are doubles (§2: 1e-150 … 1e150 m).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -78,16 +77,28 @@ def wrap(theta, period):
     return theta - period * np.ceil((theta - period / 2) / period)
 
 
-@dataclass(frozen=True)
 class Pose:
-    """A validated pose: its unit Study point (8,), its 4×4 matrix, and `floor`, the smallest
-    verification tolerance its own precision supports (0 for float64; for float32, whose
-    entries carry 7 digits, a chain of fewer than 6 joints reaches the rounded pose only to
-    about 1e-7)."""
+    """A validated pose: its 4×4 matrix, its unit Study point (8,), computed when first asked for
+    (the closed forms need the matrix alone), and `floor`, the smallest verification tolerance its
+    own precision supports (0 for float64; for float32, whose entries carry 7 digits, a chain of
+    fewer than 6 joints reaches the rounded pose only to about 1e-7)."""
 
-    study: np.ndarray
-    matrix: np.ndarray
-    floor: float = 0.0
+    def __init__(self, matrix: np.ndarray, floor: float = 0.0, study: np.ndarray | None = None) -> None:
+        self.matrix, self.floor, self._study = matrix, floor, study
+
+    @property
+    def study(self) -> np.ndarray:
+        if self._study is None:
+            M = self.matrix
+            if np.abs(M[:3, 3]).max() < HUGE:
+                self._study = from_matrix(M)
+            else:  # y = ½ t x sums products of t's entries: they may overflow
+                with np.errstate(over="ignore", invalid="ignore"):
+                    study = from_matrix(M)
+                if not np.isfinite(study).all():
+                    raise ValueError("T: the translation overflows a double in Study coordinates (entries near 1e308)")
+                self._study = study
+        return self._study
 
 
 def pose_of(T) -> Pose:
@@ -100,17 +111,12 @@ def pose_of(T) -> Pose:
     floor = 0.0 if eps <= EPS64 else FLOOR_ULPS * eps
     if A.shape == (4, 4):
         M = check_matrix(A, tol)
-        if np.abs(M[:3, 3]).max() < HUGE:
-            study = from_matrix(M)
-        else:  # y = ½ t x sums products of t's entries: they may overflow
-            with np.errstate(over="ignore", invalid="ignore"):
-                study = from_matrix(M)
-            if not np.isfinite(study).all():
-                raise ValueError("T: the translation overflows a double in Study coordinates (entries near 1e308)")
         if eps > EPS64:  # a rounded rotation: the nearest rotation, so that fk can reproduce it
-            M = to_matrix(study)
+            pose = Pose(M, floor)
+            M = to_matrix(pose.study)
             M[:3, 3] = A[:3, 3]
-        return Pose(study, M, floor)
+            return Pose(M, floor, pose.study)
+        return Pose(M, floor)
     if A.shape == (8,):
         study = _unit_study(A, tol)
         if np.abs(study[4:]).max() < HUGE:
@@ -120,7 +126,7 @@ def pose_of(T) -> Pose:
                 M = to_matrix(study)
             if not np.isfinite(M).all():
                 raise ValueError("T: the Study point's translation 2·y·x̃ overflows a double")
-        return Pose(study, M, floor)
+        return Pose(M, floor, study)
     raise ValueError(f"T: expected a 4x4 transform or an 8-vector Study point, got shape {A.shape}")
 
 

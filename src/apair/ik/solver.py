@@ -20,12 +20,12 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import elimination1a5r, elimination6r, homotopy
+from . import elimination1a5r, elimination6r, homotopy, wrist
 from .elimination4 import CAND_TOL, Elimination
 from .families import classify
 from .local import local_search, on_continuum
@@ -60,8 +60,9 @@ class Solution:
     the base, so no joint vector reaches it); note: why it is not certified, or how it was where
     the method alone did not (a singular pose certified by a pose moved by 1e-6), else empty;
     family: the key of the chain's kinematic family (`apair.ik.families`: which axes are parallel or
-    meet, "general" where no subproblem decomposition is known). The family is recognised, but every
-    family is solved by the general methods above (`method` says which)."""
+    meet, "general" where no subproblem decomposition is known). Six R-pairs with a spherical wrist
+    are solved in closed form (method "closed form", apair.ik.wrist: complex_count None; at a
+    continuum one member of it, named in `note`); the other families by the general methods."""
 
     q: NDArray[np.float64]
     error: NDArray[np.float64]
@@ -69,7 +70,7 @@ class Solution:
     complex_count: int | None = None
     certified: bool = True
     inside: NDArray[np.bool_] | None = None  # (k,) within the chain's joint limits (set by AChain.ik)
-    method: str = "elimination"  # or "homotopy" (n = 5, 6), "local search" (the fallback), "reach bound"
+    method: str = "elimination"  # or "closed form", "homotopy" (n = 5, 6), "local search" (the fallback), "reach bound"
     note: str = ""  # why the set is not certified, or how it was where not by the method alone
     family: str = ""  # the chain's kinematic family (apair.ik.families; "unclassified" for n != 6)
 
@@ -137,6 +138,7 @@ class Solver:
         self.chain = chain
         self.family = classify(chain)
         self.scale = length_scale(chain)
+        self._wrist = wrist.Wrist(chain, self.scale) if wrist.applies(chain, self.family) else None
         self.slides = np.array([p.kind == "prismatic" for p in chain.pairs])
         # the reach bound counts a P-pair's slide within its limits; its solutions are any real d
         self.reach = math.inf if self.slides.any() else reach_of(chain)
@@ -153,7 +155,8 @@ class Solver:
     def solve(self, T: ArrayLike, tol: float = 1e-9, count_complex: bool = False) -> Solution:
         """All real solutions at T, verified to tol (rotation entries; translations in units of
         the chain's length scale; a float32 pose to its own precision at least, `Pose.floor`)."""
-        return dataclasses.replace(self._solve(T, tol, count_complex), family=self.family.key)
+        sol = self._solve(T, tol, count_complex)
+        return sol if sol.family else dataclasses.replace(sol, family=self.family.key)
 
     def _solve(self, T: ArrayLike, tol: float, count_complex: bool) -> Solution:
         pose = pose_of(T)
@@ -161,6 +164,8 @@ class Solver:
         if self._beyond_reach(pose.matrix, count_complex):
             n = self.chain.n
             return Solution(np.zeros((0, n)), np.zeros(0), 0, None, method="reach bound")
+        if self._wrist is not None:
+            return self._solve_wrist(pose, tol)
         if self.chain.n >= 5 or self.slides.any():
             return self._solve_homotopy(pose, tol)
         return self._solve_elimination(pose, tol, count_complex)
@@ -231,6 +236,16 @@ class Solver:
         else:
             note = f"the elimination degenerated at this pose{why}, and a local search found no solution"
         return Solution(q, err, 0, None, certified=False, method="local search", note=note)
+
+    def _solve_wrist(self, pose: Pose, tol: float) -> Solution:
+        """A spherical wrist (apair.ik.wrist): every real solution in closed form, verified. Where
+        the polynomial vanishes identically (a design the closed form does not separate) the
+        homotopy answers."""
+        try:
+            q, err, candidates, note = cast(wrist.Wrist, self._wrist).solve(pose.matrix, tol)
+        except ValueError:
+            return self._solve_homotopy(pose, tol)
+        return Solution(q, err, candidates, None, method="closed form", note=note, family=self.family.key)
 
     def _solve_homotopy(self, pose: Pose, tol: float) -> Solution:
         """n = 5, 6 and chains with P-pairs: R-chains by the 6R elimination

@@ -1,0 +1,160 @@
+"""The closed-form inverse kinematics of arms with a spherical wrist (issue 42) against EAIK and
+IK-Geo, side by side on the same poses in one run (`bench/run.py --ik-closed-only`, and in the full
+run): single Python calls (apair's `chain.ik(T)`, EAIK's `IK(T)`, IK-Geo's `get_ik(R, t)`,
+interleaved pose by pose), apair's batched C call (`apair._native.ik_wrist` on N poses) against
+EAIK's `IK_batched`, and how the solution sets agree (every solution of a peer that apair's fk
+verifies must be among apair's). The load average is recorded with the numbers."""
+
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+
+import apair
+from apair.ik.poses import length_scale
+from apair.ik.wrist import Wrist
+from apair.kernels import native_module
+
+PI = np.pi
+ARMS = {  # standard DH (a, alpha, d), the arms of tests/ik/test_ik_wrist.py
+    "PUMA560": ([0, 0.4318, 0.0203, 0, 0, 0], [-PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0], [0, 0, 0.15005, 0.4318, 0, 0]),
+    "KUKA-KR6": ([0.025, 0.455, 0.035, 0, 0, 0], [-PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0], [0.4, 0, 0, 0.42, 0, 0.08]),
+    "ABB-IRB6640": (
+        [0.32, 1.075, 0.2, 0, 0, 0],
+        [-PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0],
+        [0.78, 0, 0, 1.1425, 0, 0.2],
+    ),
+    "Fanuc-M20": (
+        [0.075, 0.84, 0.215, 0, 0, 0],
+        [-PI / 2, PI, -PI / 2, PI / 2, -PI / 2, PI],
+        [0.525, 0, 0, -0.89, 0, -0.09],
+    ),
+    "Staubli-TX90": (
+        [0.05, 0.425, 0, 0, 0, 0],
+        [-PI / 2, 0, PI / 2, -PI / 2, PI / 2, 0],
+        [0.478, 0, 0.05, 0.425, 0, 0.1],
+    ),
+}
+SAME = 1e-6
+
+
+def _among(q, sols) -> bool:
+    d = np.abs((np.asarray(sols).reshape(-1, 6) - q + PI) % (2 * PI) - PI)
+    return bool(np.any(np.all(d < SAME, axis=1)))
+
+
+def _ikgeo(eaik_robot, chain):
+    """IK-Geo's solver of the arm's family (spherical wrist with 2∥3), with its frame conventions
+    read off fk at q = 0 (its rotations come transposed; its end frame differs from DH's by a
+    rotation), or None where IK-Geo is missing."""
+    try:
+        import ik_geo
+    except ImportError:
+        return None
+    H, P = np.asarray(eaik_robot.getOriginal_H()).T, np.asarray(eaik_robot.getOriginal_P()).T
+    geo = ik_geo.Robot.spherical_two_parallel(H.tolist(), P.tolist())
+    R0, _ = geo.forward_kinematics([0.0] * 6)
+    tool = np.asarray(R0) @ chain.fk(np.zeros(6))[:3, :3]
+
+    def solve(T):
+        R = (T[:3, :3] @ tool.T).T
+        return geo.get_ik(R.tolist(), T[:3, 3].tolist())
+
+    return solve, tool
+
+
+def section(quick: bool) -> dict:
+    from eaik.IK_DH import DhRobot
+
+    native, _ = native_module()
+    count, batch = (300, 2000) if quick else (2000, 20000)
+    out: dict = {"load_average": os.getloadavg()[0], "poses": count, "batch": batch, "arms": {}}
+    for name, (a, alpha, d) in ARMS.items():
+        chain = apair.AChain([apair.APair.revolute()] * 6, a=a, alpha=alpha, offset=d)
+        eaik = DhRobot(np.array(alpha, float), np.array(a, float), np.array(d, float))
+        geo = _ikgeo(eaik, chain)
+        rng = np.random.default_rng(42)
+        Ts = chain.fk(rng.uniform(-PI, PI, (count, 6)))
+        chain.ik(Ts[0])
+        eaik.IK(Ts[0])
+        times = {"apair": [], "eaik": []}
+        if geo is not None:
+            times["ik_geo"] = []
+            geo[0](Ts[0])
+        missing = 0
+        for T in Ts:  # interleaved, pose by pose
+            t0 = time.perf_counter()
+            ours = chain.ik(T)
+            t1 = time.perf_counter()
+            theirs = eaik.IK(T)
+            t2 = time.perf_counter()
+            times["apair"].append(t1 - t0)
+            times["eaik"].append(t2 - t1)
+            if geo is not None:
+                t3 = time.perf_counter()
+                geo[0](T)
+                times["ik_geo"].append(time.perf_counter() - t3)
+            for s in np.asarray(theirs.Q).reshape(-1, 6):
+                if np.abs(chain.fk(s) - T).max() <= 1e-9 and not _among(s, ours):
+                    missing += 1
+        row = {
+            "family": chain.kinematic_family().key,
+            "median_us": {k: float(np.median(v) * 1e6) for k, v in times.items()},
+            "eaik_solutions_missing_from_apair": missing,
+        }
+        if native is not None:
+            w = Wrist(chain, length_scale(chain))
+            Tb = chain.fk(rng.uniform(-PI, PI, (batch, 6)))
+            best = min(_timed(lambda: native.ik_wrist(w.dh, w.scale, Tb, 1e-9)) for _ in range(5))
+            row["batched_us_per_pose"] = {"apair": best / batch * 1e6}
+            poses = [Tk for Tk in Tb]
+            try:
+                best_e = min(_timed(lambda: eaik.IK_batched(poses, num_worker_threads=1)) for _ in range(3))
+                row["batched_us_per_pose"]["eaik_one_thread"] = best_e / batch * 1e6
+            except (AttributeError, TypeError):
+                pass
+        out["arms"][name] = row
+        med = row["median_us"]
+        print(
+            f"  {name:13s} {row['family']:31s} single call: apair {med['apair']:7.1f} µs, EAIK {med['eaik']:5.1f} µs"
+            + (f", IK-Geo {med['ik_geo']:5.1f} µs" if "ik_geo" in med else "")
+            + (
+                "; batched µs/pose: " + ", ".join(f"{k} {v:.2f}" for k, v in row["batched_us_per_pose"].items())
+                if "batched_us_per_pose" in row
+                else ""
+            )
+            + f"; EAIK solutions missing from apair's: {missing}",
+            flush=True,
+        )
+    return out
+
+
+def _timed(fn) -> float:
+    t0 = time.perf_counter()
+    fn()
+    return time.perf_counter() - t0
+
+
+def targets(r: dict) -> list[dict]:
+    """Issue 42's targets for arms with a spherical wrist, each met or missed."""
+    out = []
+    for name, row in r["arms"].items():
+        med = row["median_us"]
+        ratio = med["apair"] / med["eaik"]
+        out.append({"target": f"{name}: single call <= 0.5 x EAIK", "measured": ratio, "met": ratio <= 0.5})
+        if "ik_geo" in med:
+            ratio = med["apair"] / med["ik_geo"]
+            out.append({"target": f"{name}: single call <= 1.0 x IK-Geo", "measured": ratio, "met": ratio <= 1.0})
+        if "batched_us_per_pose" in row:
+            b = row["batched_us_per_pose"]["apair"]
+            out.append({"target": f"{name}: batched <= 1 µs per pose", "measured": b, "met": b <= 1.0})
+        out.append(
+            {
+                "target": f"{name}: every EAIK solution among apair's",
+                "measured": row["eaik_solutions_missing_from_apair"],
+                "met": row["eaik_solutions_missing_from_apair"] == 0,
+            }
+        )
+    return out
