@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 import tomllib
 
 import numpy as np
@@ -31,11 +30,9 @@ def run(monkeypatch, capsys):
 def test_ur5_import(run, tmp_path) -> None:
     urdf_path = robots_dir() / "ur_description" / "urdf" / "ur5_robot.urdf"
     out = tmp_path / "ur5.toml"
-    t0 = time.perf_counter()
+    # its time (< 1 s for the Panda) is measured by make bench, not here: a shared machine's load decides a timed test
     code, stdout, err = run("import", "urdf", str(urdf_path), "--tip", "tool0", "--out", str(out))
-    elapsed = time.perf_counter() - t0
     assert code == 0, err
-    assert elapsed < 1.0, elapsed
     assert f"chain file written to {out} (6 joints;" in stdout
     chain = apair.load(out)  # the file reads back, [tool] included, into load_urdf's chain
     ref = load_urdf(urdf_path, "tool0")
