@@ -62,14 +62,9 @@ def applies(chain, family: Classification) -> bool:
     )
 
 
-def _rx(alpha: float) -> NDArray[np.float64]:
-    c, s = math.cos(alpha), math.sin(alpha)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def _rz(psi: float) -> NDArray[np.float64]:
-    c, s = math.cos(psi), math.sin(psi)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+def _rotation(alpha: float, psi: float) -> NDArray[np.float64]:
+    """Rz(ψ)·Rx(α): the rotation of one DH joint (apair.frames.dh_matrix's)."""
+    return dh_matrix(0.0, alpha, 0.0, psi)[:3, :3]
 
 
 def _real_roots(coeffs: NDArray[np.float64], ref: float) -> tuple[list[float], bool]:
@@ -103,7 +98,7 @@ class Wrist:
         self.m3 = (dh_matrix(a[2], alpha[2], c[2], 0.0) @ np.array([0.0, 0.0, c[3], 1.0]))[:3]
         self.ca4, self.sa4 = math.cos(alpha[3]), math.sin(alpha[3])
         self.ca5, self.sa5 = math.cos(alpha[4]), math.sin(alpha[4])
-        self.rx6t = _rx(alpha[5]).T
+        self.rx6t = _rotation(alpha[5], 0.0).T
 
     def solve(self, Tm: NDArray[np.float64], tol: float) -> tuple[NDArray[np.float64], NDArray[np.float64], int, str]:
         """Every real solution (k, 6) at frame 6's pose Tm, verified to tol, their errors, the
@@ -153,7 +148,7 @@ class Wrist:
         out: list[list[float]] = []
         free: set[str] = set()
         for psi3 in psi3s:
-            m = _rz(psi3) @ self.m3
+            m = _rotation(0.0, psi3) @ self.m3
             p = self.B2[:3, :3] @ m + self.B2[:3, 3]
             for psi1, psi2 in self._shoulder(W, r, h, p, free):
                 R3 = self._r03(psi1, psi2, psi3)
@@ -222,7 +217,7 @@ class Wrist:
             qx, qy = s5 * sa5, -ca4 * cs5 * sa5 - sa4 * ca5
             if math.hypot(qx, qy) <= SINGULAR:
                 free.add(FLAGS[1])
-                N = (_rx(self.dh[3, 1]) @ _rz(psi5) @ _rx(self.dh[4, 1])).T @ M
+                N = (_rotation(self.dh[3, 1], 0.0) @ _rotation(self.dh[4, 1], psi5)).T @ M
                 out.append((0.0, psi5, math.atan2(N[1, 0], N[0, 0])))
                 continue
             psi4 = math.atan2(M[1, 2], M[0, 2]) - math.atan2(qy, qx)
