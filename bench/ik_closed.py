@@ -1,7 +1,8 @@
-"""The closed-form inverse kinematics of arms with a spherical wrist (issue 42) against EAIK and
-IK-Geo, side by side on the same poses in one run (`bench/run.py --ik-closed-only`, and in the full
-run): single Python calls (apair's `chain.ik(T)`, EAIK's `IK(T)`, IK-Geo's `get_ik(R, t)`,
-interleaved pose by pose), apair's batched C call (`apair._native.ik_wrist` on N poses) against
+"""The closed-form inverse kinematics of arms with a spherical wrist and of UR arms (three parallel
+inner axes; issue 42) against EAIK and IK-Geo, side by side on the same poses in one run
+(`bench/run.py --ik-closed-only`, and in the full run): single Python calls (apair's `chain.ik(T)`,
+EAIK's `IK(T)`, IK-Geo's `get_ik(R, t)`, interleaved pose by pose), apair's batched C call
+(`apair._native.ik_wrist` or `ik_parallel` on N poses) against
 EAIK's `IK_batched`, and how the solution sets agree (every solution of a peer that apair's fk
 verifies must be among apair's). The load average is recorded with the numbers."""
 
@@ -13,12 +14,13 @@ import time
 import numpy as np
 
 import apair
+from apair.ik.parallel import Parallel
 from apair.ik.poses import length_scale
 from apair.ik.wrist import Wrist
 from apair.kernels import native_module
 
 PI = np.pi
-ARMS = {  # standard DH (a, alpha, d), the arms of tests/ik/test_ik_wrist.py
+ARMS = {  # standard DH (a, alpha, d), the arms of tests/ik/test_ik_wrist.py and test_ik_parallel.py
     "PUMA560": ([0, 0.4318, 0.0203, 0, 0, 0], [-PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0], [0, 0, 0.15005, 0.4318, 0, 0]),
     "KUKA-KR6": ([0.025, 0.455, 0.035, 0, 0, 0], [-PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0], [0.4, 0, 0, 0.42, 0, 0.08]),
     "ABB-IRB6640": (
@@ -36,7 +38,19 @@ ARMS = {  # standard DH (a, alpha, d), the arms of tests/ik/test_ik_wrist.py
         [-PI / 2, 0, PI / 2, -PI / 2, PI / 2, 0],
         [0.478, 0, 0.05, 0.425, 0, 0.1],
     ),
+    "UR5": (
+        [0, -0.425, -0.39225, 0, 0, 0],
+        [PI / 2, 0, 0, PI / 2, -PI / 2, 0],
+        [0.089159, 0, 0, 0.10915, 0.09465, 0.0823],
+    ),
+    "UR10e": (
+        [0, -0.6127, -0.57155, 0, 0, 0],
+        [PI / 2, 0, 0, PI / 2, -PI / 2, 0],
+        [0.1807, 0, 0, 0.17415, 0.11985, 0.11655],
+    ),
 }
+# IK-Geo's solver of each family (its names: h2∥h3∥h4 with h5∩h6 is three_parallel_two_intersecting)
+IKGEO = {"three-inner-parallel": "three_parallel_two_intersecting"}
 SAME = 1e-6
 
 
@@ -46,7 +60,7 @@ def _among(q, sols) -> bool:
 
 
 def _ikgeo(eaik_robot, chain):
-    """IK-Geo's solver of the arm's family (spherical wrist with 2∥3), with its frame conventions
+    """IK-Geo's solver of the arm's family (spherical wrist with 2∥3, or UR's), with its frame conventions
     read off fk at q = 0 (its rotations come transposed; its end frame differs from DH's by a
     rotation), or None where IK-Geo is missing."""
     try:
@@ -54,7 +68,8 @@ def _ikgeo(eaik_robot, chain):
     except ImportError:
         return None
     H, P = np.asarray(eaik_robot.getOriginal_H()).T, np.asarray(eaik_robot.getOriginal_P()).T
-    geo = ik_geo.Robot.spherical_two_parallel(H.tolist(), P.tolist())
+    make = IKGEO.get(chain.kinematic_family().key, "spherical_two_parallel")
+    geo = getattr(ik_geo.Robot, make)(H.tolist(), P.tolist())
     R0, _ = geo.forward_kinematics([0.0] * 6)
     tool = np.asarray(R0) @ chain.fk(np.zeros(6))[:3, :3]
 
@@ -105,9 +120,11 @@ def section(quick: bool) -> dict:
             "eaik_solutions_missing_from_apair": missing,
         }
         if native is not None:
-            w = Wrist(chain, length_scale(chain))
+            parallel = chain.kinematic_family().key == "three-inner-parallel"
+            w = (Parallel if parallel else Wrist)(chain, length_scale(chain))
+            solve = native.ik_parallel if parallel else native.ik_wrist
             Tb = chain.fk(rng.uniform(-PI, PI, (batch, 6)))
-            best = min(_timed(lambda: native.ik_wrist(w.dh, w.scale, Tb, 1e-9)) for _ in range(5))
+            best = min(_timed(lambda: solve(w.dh, w.scale, Tb, 1e-9)) for _ in range(5))
             row["batched_us_per_pose"] = {"apair": best / batch * 1e6}
             poses = [Tk for Tk in Tb]
             try:
@@ -138,7 +155,7 @@ def _timed(fn) -> float:
 
 
 def targets(r: dict) -> list[dict]:
-    """Issue 42's targets for arms with a spherical wrist, each met or missed."""
+    """Issue 42's targets for the special R arms (spherical wrist, UR), each met or missed."""
     out = []
     for name, row in r["arms"].items():
         med = row["median_us"]

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 79a0155b9108e372
+Content hash: 98ccb36936ce00d4
 """

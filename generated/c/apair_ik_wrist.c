@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_wrist.c (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_wrist.c. Content hash: 5d4daa387929b90b
+ * generated/c. Do not edit: edit src/csrc/apair_ik_wrist.c. Content hash: 34f790c6f330b8db
  */
 /*
  * The closed-form inverse kinematics of six-joint R-chains with a spherical wrist (apair.ik.wrist,
@@ -8,179 +8,21 @@
  * chain_ik_wrist.py) gives the wrist point and the polynomial in t = tan(psi_3/2); its real roots
  * (isolated between the real roots of its derivatives, then bisected) give psi_3, the shoulder's
  * psi_1, psi_2 and the wrist's psi_4, psi_5, psi_6 follow in closed form, and each candidate gets up
- * to two Gauss-Newton steps on fk6 and jacobian6 and is kept where fk reproduces the pose to tol.
+ * to two Gauss-Newton steps on fk6 and jacobian6 and is kept where fk reproduces the pose to tol
+ * (apair_ik_closed.h, shared with apair_ik_parallel.c).
  * Hand-written C: the C backend of codegen copies it into generated/c, the library it belongs to.
  * Declared in apair.h (template: codegen/backends/c/templates/apair.h.j2).
  */
-#include "apair_ik_internal.h"
+#include "apair_ik_closed.h"
 
-#define WRIST_FLAT 1e-9      /* a length (relative to the scale), a sine or a coefficient this small is zero */
-#define WRIST_SINGULAR 1e-7  /* psi_5 this close to 0 or pi is taken as there */
 #define WRIST_CONTINUUM 1e-6 /* a verified solution this close to axes 4 and 6 in line is one of their continuum */
-#define WRIST_DOUBLE 1e-14   /* u_x^2 + u_y^2 = p_x^2 + p_y^2 within this (relative): one sign, not two */
-#define WRIST_TANGENT 1e-8   /* a local extremum of the polynomial this close to 0 (relative) is a root */
-#define WRIST_INV_MAX 1024
-#define WRIST_PI 3.14159265358979323846
-#define WRIST_ROOTS 16    /* room for real_roots' answer: at most 2d - 1 per level, 11 for d = 4 */
-
-GAUSS_SOLVE(wrist_solve6, double, fabs)
 
 typedef struct {
-    const apair_kernel *fk, *jac;
-    double inv_fk[WRIST_INV_MAX], inv_jac[WRIST_INV_MAX];
-    double turning[6];
+    closed_fk k;
     int which;               /* 0: quartic; 1: (A), a_1 = 0; 2: (B), sin alpha_1 = 0 */
     double a1, ca1, sa1, B2[12], m3[3], ca4, sa4, ca5, sa5, alpha[6], phi[6], ca[6], sa[6];
-    double inv_pos[WRIST_INV_MAX];
+    double inv_pos[CLOSED_INV_MAX];
 } wrist_design;
-
-static double horner(int d, const double *c, double x)
-{
-    double s = c[d];
-    for (int k = d - 1; k >= 0; k--) s = s * x + c[k];
-    return s;
-}
-
-static double magnitude(int d, const double *c, double x)
-{
-    double s = 0.0, ax = fabs(x), p = 1.0;
-    for (int k = 0; k <= d; k++, p *= ax) s += fabs(c[k]) * p;
-    return s;
-}
-
-/* The real roots of sum c_k x^k (degree d <= 4, c[d] != 0): a root in each interval between the
- * real roots of the derivative where the sign changes, and each critical point within
- * WRIST_TANGENT of zero (a double root, or two roots too close to separate): candidates, some
- * repeated, at most 11 for d = 4. */
-static int real_roots(int d, const double *c, double *roots)
-{
-    if (d <= 0) return 0;
-    if (d == 1) { roots[0] = -c[0] / c[1]; return 1; }
-    if (d == 2) { /* the stable formula; a negative discriminant within WRIST_TANGENT of 0: a double root */
-        double disc = c[1] * c[1] - 4 * c[2] * c[0];
-        if (disc < 0) {
-            if (-disc > WRIST_TANGENT * (c[1] * c[1] + fabs(4 * c[2] * c[0]))) return 0;
-            roots[0] = -c[1] / (2 * c[2]);
-            return 1;
-        }
-        double qq = -0.5 * (c[1] + copysign(sqrt(disc), c[1]));
-        double r1 = qq / c[2], r2 = qq != 0.0 ? c[0] / qq : -r1;
-        roots[0] = fmin(r1, r2);
-        roots[1] = fmax(r1, r2);
-        return 2;
-    }
-    double dc[4], crit[WRIST_ROOTS];
-    for (int k = 1; k <= d; k++) dc[k - 1] = k * c[k];
-    int nc = real_roots(d - 1, dc, crit);
-    double bound = 0.0;
-    for (int k = 0; k < d; k++) bound = fmax(bound, fabs(c[k] / c[d]));
-    bound += 1.0;
-    double ends[WRIST_ROOTS + 2];
-    int ne = 0;
-    ends[ne++] = -bound;
-    for (int k = 0; k < nc; k++) ends[ne++] = fmin(fmax(crit[k], -bound), bound);
-    ends[ne++] = bound;
-    int n = 0;
-    for (int k = 0; k + 1 < ne; k++) {
-        double lo = ends[k], hi = ends[k + 1], flo = horner(d, c, lo), fhi = horner(d, c, hi);
-        if (k > 0 && fabs(flo) <= WRIST_TANGENT * magnitude(d, c, lo)) roots[n++] = lo; /* at a critical point */
-        if (flo == 0.0) continue;
-        if ((flo < 0) == (fhi < 0)) continue;
-        /* Newton's method from the secant point, kept inside the bracket (a bisection step where it
-         * would leave it), to 1e-14 relative: the candidates are polished on fk afterwards */
-        double x = lo - flo * (hi - lo) / (fhi - flo);
-        if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
-        for (int it = 0; it < 100; it++) {
-            double f = c[d], df = 0.0;
-            for (int k = d - 1; k >= 0; k--) { df = df * x + f; f = f * x + c[k]; }
-            if (f == 0.0) break;
-            if ((f < 0) == (flo < 0)) lo = x; else hi = x;
-            double next = x - f / df;
-            if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-            if (fabs(next - x) <= 1e-14 * fmax(1.0, fabs(x)) || hi - lo <= 1e-14 * fmax(1.0, fabs(lo))) { x = next; break; }
-            x = next;
-        }
-        roots[n++] = x;
-    }
-    return n;
-}
-
-static void dh4(double a, double ca, double sa, double c, double psi, double *A) /* Rz(psi) Tz(c) Tx(a) Rx(alpha), 3 x 4 */
-{
-    double ct = cos(psi), st = sin(psi);
-    double m[12] = {ct, -st * ca, st * sa, a * ct, st, ct * ca, -ct * sa, a * st, 0.0, sa, ca, c};
-    memcpy(A, m, sizeof m);
-}
-
-static void mul34(const double *A, const double *B, double *C) /* rigid 3 x 4 products */
-{
-    double t[12];
-    for (int r = 0; r < 3; r++)
-        for (int k = 0; k < 4; k++)
-            t[4 * r + k] = A[4 * r] * B[k] + A[4 * r + 1] * B[4 + k] + A[4 * r + 2] * B[8 + k] + (k == 3 ? A[4 * r + 3] : 0.0);
-    memcpy(C, t, sizeof t);
-}
-
-static double wrap(double x) /* into (-pi, pi], as apair.ik.poses.wrap */
-{
-    return x - 2 * WRIST_PI * ceil((x - WRIST_PI) / (2 * WRIST_PI));
-}
-
-/* fk and (if J) the Jacobian (6 x 6) at joint angles q; the pose error e as apair.ik.poses:
- * [(t_T - t) / scale; rotation]; returns the largest entry of |fk - T|, translations / scale. */
-static double evaluate(const wrist_design *w, const double *dh, double scale, const double *q, const double *Tt,
-                       double *e, double *J)
-{
-    double law[30], T[16];
-    for (int i = 0; i < 6; i++) {
-        law[5 * i] = cos(0.5 * q[i]);
-        law[5 * i + 1] = sin(0.5 * q[i]);
-        law[5 * i + 2] = law[5 * i + 3] = law[5 * i + 4] = 0.0;
-    }
-    const double *in[3] = {law, dh, w->turning};
-    double *outT[1] = {T};
-    if (w->fk->n_invariants) w->fk->core(w->inv_fk, in, outT); else w->fk->eval(in, outT);
-    if (J) {
-        double *outJ[1] = {J};
-        if (w->jac->n_invariants) w->jac->core(w->inv_jac, in, outJ); else w->jac->eval(in, outJ);
-    }
-    double worst = 0.0;
-    for (int k = 0; k < 12; k++) {
-        double d = fabs(T[k] - Tt[k]) / (k % 4 == 3 ? scale : 1.0);
-        if (d > worst) worst = d;
-    }
-    for (int r = 0; r < 3; r++) e[r] = (Tt[4 * r + 3] - T[4 * r + 3]) / scale;
-    double S[9];
-    for (int r = 0; r < 3; r++)
-        for (int k = 0; k < 3; k++) S[3 * r + k] = Tt[4 * r] * T[4 * k] + Tt[4 * r + 1] * T[4 * k + 1] + Tt[4 * r + 2] * T[4 * k + 2];
-    e[3] = 0.5 * (S[7] - S[5]);
-    e[4] = 0.5 * (S[2] - S[6]);
-    e[5] = 0.5 * (S[3] - S[1]);
-    return isfinite(worst) ? worst : INFINITY;
-}
-
-/* Up to two Gauss-Newton steps (as apair.ik.poses.refine); the error of the result. */
-static double polish(const wrist_design *w, const double *dh, double scale, const double *Tt, double tol, double *q)
-{
-    double e[6], J[36];
-    double err = evaluate(w, dh, scale, q, Tt, e, NULL);
-    if (err > 1e-3 * tol) evaluate(w, dh, scale, q, Tt, e, J); /* the Jacobian only where a step is taken */
-    for (int step = 0; step < 2 && err > 1e-3 * tol; step++) {
-        double A[36], x[6], trial[6], e2[6], J2[36];
-        for (int r = 0; r < 6; r++)
-            for (int k = 0; k < 6; k++) A[6 * r + k] = J[6 * r + k] / (r < 3 ? scale : 1.0);
-        memcpy(x, e, sizeof x);
-        if (wrist_solve6(6, A, 1, x)) break;
-        for (int i = 0; i < 6; i++) trial[i] = q[i] + x[i];
-        double err2 = evaluate(w, dh, scale, trial, Tt, e2, J2);
-        if (!(err2 < err)) break;
-        memcpy(q, trial, sizeof trial);
-        memcpy(e, e2, sizeof e);
-        memcpy(J, J2, sizeof J);
-        err = err2;
-    }
-    return err;
-}
 
 /* psi_1, psi_2 for the wrist point W at psi_3 (p: its position in frame 1 before psi_2) */
 static int shoulder(const wrist_design *w, double scale, const double *W, double r, double h, const double *p,
@@ -197,7 +39,7 @@ static int shoulder(const wrist_design *w, double scale, const double *W, double
         double rest = pxy2 - known * known;
         if (rest < -1e-6 * (pxy2 + scale * scale)) return 0;
         /* a double root (rest 0, rounded): sqrt would put both signs 1e-8 off it */
-        double other = rest <= WRIST_DOUBLE * (pxy2 + scale * scale) ? 0.0 : sqrt(rest);
+        double other = rest <= CLOSED_DOUBLE * (pxy2 + scale * scale) ? 0.0 : sqrt(rest);
         for (int s = 0; s < (other > 0 ? 2 : 1); s++) {
             double o = s ? -other : other;
             u[2 * nu] = w->which == 1 ? o : known;
@@ -205,7 +47,7 @@ static int shoulder(const wrist_design *w, double scale, const double *W, double
             nu++;
         }
     }
-    double tiny = (WRIST_FLAT * scale) * (WRIST_FLAT * scale);
+    double tiny = (CLOSED_FLAT * scale) * (CLOSED_FLAT * scale);
     for (int k = 0; k < nu; k++) {
         double ux = u[2 * k], uy = u[2 * k + 1], vx = w->a1 + ux, vy = w->ca1 * uy - w->sa1 * p[2];
         /* the turn taking (x1, y1) to (x2, y2) in one atan2 */
@@ -226,15 +68,15 @@ static int wrist(const wrist_design *w, const double *M, double *psi456, int *fl
     double qy0 = w->ca4 * fmin(1.0, fmax(-1.0, c5)) * w->sa5 + w->sa4 * w->ca5;
     double s5a = sqrt(fmax(0.0, M[2] * M[2] + M[5] * M[5] - qy0 * qy0)) / fabs(w->sa5);
     double base = atan2(s5a, c5);
-    if (base <= WRIST_SINGULAR) base = 0.0;
-    else if (base >= WRIST_PI - WRIST_SINGULAR) base = WRIST_PI;
+    if (base <= CLOSED_SINGULAR) base = 0.0;
+    else if (base >= CLOSED_PI - CLOSED_SINGULAR) base = CLOSED_PI;
     int n = 0;
-    for (int s = 0; s < (base > 0 && base < WRIST_PI ? 2 : 1); s++) {
+    for (int s = 0; s < (base > 0 && base < CLOSED_PI ? 2 : 1); s++) {
         double psi5 = s ? -base : base, s5 = sin(psi5), cs5 = cos(psi5);
         double qx = s5 * w->sa5, qy = -w->ca4 * cs5 * w->sa5 - w->sa4 * w->ca5;
         double *out = psi456 + 3 * n++;
         out[1] = psi5;
-        if (hypot(qx, qy) <= WRIST_SINGULAR) { /* axes 4 and 6 in line: psi_4 = 0, psi_6 from N = (Rx Rz Rx)^T M */
+        if (hypot(qx, qy) <= CLOSED_SINGULAR) { /* axes 4 and 6 in line: psi_4 = 0, psi_6 from N = (Rx Rz Rx)^T M */
             *flags |= 1;
             double ca4 = w->ca4, sa4 = w->sa4, ca5 = w->ca5, sa5 = w->sa5;
             /* K = Rx(alpha_4) Rz(psi_5) Rx(alpha_5), columns 0 and 1 of N = K^T M need K's rows . M's columns */
@@ -264,49 +106,34 @@ static double canonical_wrist(const wrist_design *w, const double *dh, double sc
     if (hypot(s5 * w->sa5, w->ca4 * c5 * w->sa5 + w->sa4 * w->ca5) > WRIST_CONTINUUM) return err;
     double s = w->ca4 * w->ca5 - w->sa4 * w->sa5 * c5 < 0 ? -1.0 : 1.0, y[6], e[6];
     memcpy(y, x, sizeof y);
-    y[5] = wrap(x[5] + w->phi[5] + s * (x[3] + w->phi[3]) - w->phi[5]);
-    y[3] = wrap(-w->phi[3]);
-    double err2 = evaluate(w, dh, scale, y, Tt, e, NULL);
+    y[5] = closed_wrap(x[5] + w->phi[5] + s * (x[3] + w->phi[3]) - w->phi[5]);
+    y[3] = closed_wrap(-w->phi[3]);
+    double err2 = closed_evaluate(&w->k, dh, scale, y, Tt, e, NULL);
     if (!(err2 <= tol)) return err;
     memcpy(x, y, sizeof y);
     *flags |= 1;
     return err2;
 }
 
-static int same_angles(const double *a, const double *b)
-{
-    for (int i = 0; i < 6; i++)
-        if (fabs(wrap(a[i] - b[i])) >= 1e-6) return 0;
-    return 1;
-}
-
 int apair_ik_wrist(const double *dh, double scale, size_t count, const double *target, ptrdiff_t target_stride,
                    double tol, double *q, double *error, int *found, int *candidates, int *flags)
 {
     wrist_design w;
-    w.fk = apair_find_kernel("fk6");
-    w.jac = apair_find_kernel("jacobian6");
-    if (!w.fk || !w.jac || w.fk->n_invariants > WRIST_INV_MAX || w.jac->n_invariants > WRIST_INV_MAX || !(scale > 0))
-        return -1;
-    for (int i = 0; i < 6; i++) { w.turning[i] = 1.0; w.alpha[i] = dh[4 * i + 1]; w.phi[i] = dh[4 * i + 3]; }
-    {
-        const double *in[3] = {NULL, dh, w.turning};
-        if (w.fk->n_invariants) w.fk->invariants(in, w.inv_fk);
-        if (w.jac->n_invariants) w.jac->invariants(in, w.inv_jac);
-    }
-    if (APAIR_IK_WRIST_POSITION6_INVARIANTS > WRIST_INV_MAX) return -1;
+    if (closed_fk_init(&w.k, dh) || !(scale > 0)) return -1;
+    for (int i = 0; i < 6; i++) { w.alpha[i] = dh[4 * i + 1]; w.phi[i] = dh[4 * i + 3]; }
+    if (APAIR_IK_WRIST_POSITION6_INVARIANTS > CLOSED_INV_MAX) return -1;
     apair_ik_wrist_position6_invariants(dh, w.inv_pos);
     w.a1 = dh[0]; w.ca1 = cos(dh[1]); w.sa1 = sin(dh[1]);
-    w.which = fabs(w.a1) <= WRIST_FLAT * scale ? 1 : fabs(w.sa1) <= WRIST_FLAT ? 2 : 0;
+    w.which = fabs(w.a1) <= CLOSED_FLAT * scale ? 1 : fabs(w.sa1) <= CLOSED_FLAT ? 2 : 0;
     for (int i = 0; i < 6; i++) { w.ca[i] = cos(dh[4 * i + 1]); w.sa[i] = sin(dh[4 * i + 1]); }
-    dh4(dh[4], w.ca[1], w.sa[1], dh[6], 0.0, w.B2);
+    closed_dh4(dh[4], w.ca[1], w.sa[1], dh[6], 0.0, w.B2);
     {
         double A3[12];
-        dh4(dh[8], w.ca[2], w.sa[2], dh[10], 0.0, A3);
+        closed_dh4(dh[8], w.ca[2], w.sa[2], dh[10], 0.0, A3);
         for (int r = 0; r < 3; r++) w.m3[r] = A3[4 * r + 2] * dh[14] + A3[4 * r + 3];
     }
     w.ca4 = cos(dh[13]); w.sa4 = sin(dh[13]); w.ca5 = cos(dh[17]); w.sa5 = sin(dh[17]);
-    if (fabs(w.sa4 * w.sa5) <= WRIST_FLAT) return -1; /* not a wrist: axes 4, 5 or 5, 6 parallel */
+    if (fabs(w.sa4 * w.sa5) <= CLOSED_FLAT) return -1; /* not a wrist: axes 4, 5 or 5, 6 parallel */
     double ca6 = cos(dh[21]), sa6 = sin(dh[21]);
     for (size_t j = 0; j < count; j++) {
         const double *Tt = target + (ptrdiff_t)j * target_stride;
@@ -319,15 +146,15 @@ int apair_ik_wrist(const double *dh, double scale, size_t count, const double *t
         double big = rh[0] + scale * scale, ref = w.which == 0 ? big * big : w.which == 1 ? big : sqrt(big);
         double size = 0.0;
         for (int k = 0; k <= deg; k++) size = fmax(size, fabs(c[k]));
-        if (!(size > WRIST_FLAT * ref)) { flags[j] = -1; continue; } /* the polynomial vanishes: not separated */
+        if (!(size > CLOSED_FLAT * ref)) { flags[j] = -1; continue; } /* the polynomial vanishes: not separated */
         double cn[5];
         for (int k = 0; k <= deg; k++) cn[k] = c[k] / size;
         int top = deg;
-        while (top > 0 && fabs(cn[top]) <= WRIST_FLAT) top--;
-        double psi3[WRIST_ROOTS + 1], roots[WRIST_ROOTS];
-        int n3 = real_roots(top, cn, roots);
+        while (top > 0 && fabs(cn[top]) <= CLOSED_FLAT) top--;
+        double psi3[CLOSED_ROOTS + 1], roots[CLOSED_ROOTS];
+        int n3 = closed_real_roots(top, cn, roots);
         for (int k = 0; k < n3; k++) psi3[k] = 2 * atan(roots[k]);
-        if (top < deg) psi3[n3++] = WRIST_PI;
+        if (top < deg) psi3[n3++] = CLOSED_PI;
         double R6[9] = {Tt[0], Tt[1], Tt[2], Tt[4], Tt[5], Tt[6], Tt[8], Tt[9], Tt[10]};
         for (int k3 = 0; k3 < n3; k3++) {
             double c3 = cos(psi3[k3]), s3 = sin(psi3[k3]);
@@ -337,11 +164,11 @@ int apair_ik_wrist(const double *dh, double scale, size_t count, const double *t
             int n12 = shoulder(&w, scale, W, rh[0], rh[1], p, psi12, &flags[j]);
             for (int k12 = 0; k12 < n12; k12++) {
                 double A1[12], A2[12], A3[12], A[12], M[9], R6x[9];
-                dh4(dh[0], w.ca[0], w.sa[0], dh[2], psi12[2 * k12], A1);
-                dh4(dh[4], w.ca[1], w.sa[1], dh[6], psi12[2 * k12 + 1], A2);
-                dh4(dh[8], w.ca[2], w.sa[2], dh[10], psi3[k3], A3);
-                mul34(A1, A2, A);
-                mul34(A, A3, A);
+                closed_dh4(dh[0], w.ca[0], w.sa[0], dh[2], psi12[2 * k12], A1);
+                closed_dh4(dh[4], w.ca[1], w.sa[1], dh[6], psi12[2 * k12 + 1], A2);
+                closed_dh4(dh[8], w.ca[2], w.sa[2], dh[10], psi3[k3], A3);
+                closed_mul34(A1, A2, A);
+                closed_mul34(A, A3, A);
                 /* R6 Rx(alpha_6)^T, then M = R_3^T (R6 Rx^T) */
                 for (int r = 0; r < 3; r++) {
                     R6x[3 * r] = R6[3 * r];
@@ -355,35 +182,17 @@ int apair_ik_wrist(const double *dh, double scale, size_t count, const double *t
                 for (int k456 = 0; k456 < n456; k456++) {
                     double x[6] = {psi12[2 * k12], psi12[2 * k12 + 1], psi3[k3], psi456[3 * k456], psi456[3 * k456 + 1],
                                    psi456[3 * k456 + 2]};
-                    for (int i = 0; i < 6; i++) x[i] = wrap(x[i] - w.phi[i]);
+                    for (int i = 0; i < 6; i++) x[i] = closed_wrap(x[i] - w.phi[i]);
                     candidates[j]++;
-                    double err = polish(&w, dh, scale, Tt, tol, x);
+                    double err = closed_polish(&w.k, dh, scale, Tt, tol, x);
                     if (!(err <= tol)) continue;
                     err = canonical_wrist(&w, dh, scale, Tt, tol, x, err, &flags[j]);
-                    for (int i = 0; i < 6; i++) x[i] = wrap(x[i]);
-                    int dup = -1;
-                    for (int k = 0; k < found[j] && dup < 0; k++)
-                        if (same_angles(qj + 6 * k, x)) dup = k;
-                    if (dup >= 0) {
-                        if (err < ej[dup]) { memcpy(qj + 6 * dup, x, sizeof x); ej[dup] = err; }
-                    } else if (found[j] < 8) {
-                        memcpy(qj + 6 * found[j], x, sizeof x);
-                        ej[found[j]++] = err;
-                    }
+                    for (int i = 0; i < 6; i++) x[i] = closed_wrap(x[i]);
+                    closed_keep(qj, ej, &found[j], x, err);
                 }
             }
         }
-        /* ascending by joint 1, then 2, ... (apair.ik.poses.refine's order) */
-        for (int a = 1; a < found[j]; a++)
-            for (int b = a; b > 0; b--) {
-                double *u = qj + 6 * (b - 1), *v = qj + 6 * b;
-                int k = 0;
-                while (k < 6 && u[k] == v[k]) k++;
-                if (k == 6 || u[k] < v[k]) break;
-                double t[6], te = ej[b - 1];
-                memcpy(t, u, sizeof t); memcpy(u, v, sizeof t); memcpy(v, t, sizeof t);
-                ej[b - 1] = ej[b]; ej[b] = te;
-            }
+        closed_sort(qj, ej, found[j]);
     }
     return 0;
 }

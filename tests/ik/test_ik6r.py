@@ -189,8 +189,9 @@ def test_special_designs_stay_complete(name):
             certified += 1
             assert same_sets(homotopy.canonical(problem, theta), homotopy.solve(problem, start, T).theta), name
         sol = chain.ik(T, full=True)
-        wrist = chain.kinematic_family().key.startswith("spherical-")
-        assert sol.method == ("closed form" if wrist else "elimination" if theta is not None else "homotopy")
+        family = chain.kinematic_family().key
+        closed = family.startswith("spherical-") or family == "three-inner-parallel"  # apair.ik.wrist, .parallel
+        assert sol.method == ("closed form" if closed else "elimination" if theta is not None else "homotopy")
         assert contains(sol.q, q, 1e-6), (name, q, sol.q)
         assert np.abs(chain.fk(sol.q) - T).max() <= 1e-9
     if generic:
@@ -217,7 +218,7 @@ def test_a_wrist_singularity_is_refused():
     a, alpha, c, _ = SPECIAL["PUMA-like (spherical wrist: 8 solutions)"]
     chain = arm(a, alpha, c)
     general = Solver(chain)
-    general._wrist = None
+    general._closed = None
     T = chain.fk(np.array([0.3, -0.5, 0.4, 0.7, 0.0, 0.2]))
     with pytest.raises(ValueError, match="not isolated"):
         general.solve(T)

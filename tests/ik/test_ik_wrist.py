@@ -101,7 +101,7 @@ def test_same_sets_as_eaik(name):
 def test_same_sets_as_the_general_solver(name):
     chain = arm(name)
     general = Solver(chain)
-    general._wrist = None  # the 6R elimination or the homotopy, as before the closed form
+    general._closed = None  # the 6R elimination or the homotopy, as before the closed form
     rng = np.random.default_rng(3)
     for _ in range(15):
         q = rng.uniform(-PI, PI, 6)
@@ -189,7 +189,7 @@ def test_random_poses_reachable_or_not(name):
 
     chain = arm(name)
     general = Solver(chain)
-    general._wrist = None
+    general._closed = None
     rng = np.random.default_rng(13)
     reach = float(np.sum(np.abs(ARMS[name][0])) + np.sum(np.abs(ARMS[name][2])))
     empty = 0
@@ -221,7 +221,7 @@ def test_a_pairs_and_frames():
     base and tool frames keep the closed form."""
     a, alpha, d = ARMS["PUMA560"]
     wrist_a = apair.AChain([R, R, R, R, apair.APair(0.06, 0.05), R], a=a, alpha=alpha, offset=d)
-    assert Solver(wrist_a)._wrist is None
+    assert Solver(wrist_a)._closed is None
     framed = apair.AChain(
         [R] * 6,
         a=a,

@@ -20,14 +20,14 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, NamedTuple, cast
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import elimination1a5r, elimination6r, homotopy, wrist
+from . import elimination1a5r, elimination6r, homotopy, parallel, wrist
 from .elimination4 import CAND_TOL, Elimination
-from .families import classify
+from .families import Classification, classify
 from .local import local_search, on_continuum
 from .pencil import SEED, Degenerate
 from .poses import (
@@ -61,8 +61,9 @@ class Solution:
     the method alone did not (a singular pose certified by a pose moved by 1e-6), else empty;
     family: the key of the chain's kinematic family (`apair.ik.families`: which axes are parallel or
     meet, "general" where no subproblem decomposition is known). Six R-pairs with a spherical wrist
-    are solved in closed form (method "closed form", apair.ik.wrist: complex_count None; at a
-    continuum one member of it, named in `note`); the other families by the general methods."""
+    or three parallel inner axes are solved in closed form (method "closed form", apair.ik.wrist,
+    apair.ik.parallel: complex_count None; at a continuum one member of it, named in `note`); the
+    other families by the general methods."""
 
     q: NDArray[np.float64]
     error: NDArray[np.float64]
@@ -138,7 +139,7 @@ class Solver:
         self.chain = chain
         self.family = classify(chain)
         self.scale = length_scale(chain)
-        self._wrist = wrist.Wrist(chain, self.scale) if wrist.applies(chain, self.family) else None
+        self._closed = _closed_form(chain, self.family, self.scale)
         self.slides = np.array([p.kind == "prismatic" for p in chain.pairs])
         # the reach bound counts a P-pair's slide within its limits; its solutions are any real d
         self.reach = math.inf if self.slides.any() else reach_of(chain)
@@ -164,8 +165,8 @@ class Solver:
         if self._beyond_reach(pose.matrix, count_complex):
             n = self.chain.n
             return Solution(np.zeros((0, n)), np.zeros(0), 0, None, method="reach bound")
-        if self._wrist is not None:
-            return self._solve_wrist(pose, tol)
+        if self._closed is not None:
+            return self._solve_closed(self._closed, pose, tol)
         if self.chain.n >= 5 or self.slides.any():
             return self._solve_homotopy(pose, tol)
         return self._solve_elimination(pose, tol, count_complex)
@@ -237,12 +238,12 @@ class Solver:
             note = f"the elimination degenerated at this pose{why}, and a local search found no solution"
         return Solution(q, err, 0, None, certified=False, method="local search", note=note)
 
-    def _solve_wrist(self, pose: Pose, tol: float) -> Solution:
-        """A spherical wrist (apair.ik.wrist): every real solution in closed form, verified. Where
-        the polynomial vanishes identically (a design the closed form does not separate) the
-        homotopy answers."""
+    def _solve_closed(self, closed: wrist.Wrist | parallel.Parallel, pose: Pose, tol: float) -> Solution:
+        """A spherical wrist (apair.ik.wrist) or three parallel inner axes (apair.ik.parallel):
+        every real solution in closed form, verified. Where the polynomial vanishes identically (a
+        pose or design the closed form does not separate) the homotopy answers."""
         try:
-            q, err, candidates, note = cast(wrist.Wrist, self._wrist).solve(pose.matrix, tol)
+            q, err, candidates, note = closed.solve(pose.matrix, tol)
         except ValueError:
             return self._solve_homotopy(pose, tol)
         return Solution(q, err, candidates, None, method="closed form", note=note, family=self.family.key)
@@ -318,6 +319,18 @@ class Solver:
         """The homotopy's real joint values (m, n) as the chain's: a P-pair's slide from units of
         the length scale to metres (angles as they are)."""
         return np.where(self.slides, real * self.scale, real)
+
+
+def _closed_form(chain: ChainLike, family: Classification, scale: float) -> wrist.Wrist | parallel.Parallel | None:
+    """The closed-form solver of the chain's family, if it has one (apair.ik.wrist, apair.ik.parallel)."""
+    if wrist.applies(chain, family):
+        return wrist.Wrist(chain, scale)
+    if parallel.applies(chain, family):
+        try:
+            return parallel.Parallel(chain, scale)
+        except ValueError:  # a design the closed form does not cover (axes 5 and 6 one line)
+            return None
+    return None
 
 
 def _unaccounted(ends: Endpoints) -> str:

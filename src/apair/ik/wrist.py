@@ -28,14 +28,11 @@ from numpy.typing import NDArray
 
 from ..frames import dh_matrix
 from ..kernels import call, native_in_use
+from .closed import DOUBLE, FLAT, SINGULAR, note, real_roots
 from .families import Classification
 from .poses import pose_error, refine, wrap
 
-ROOT_IMAG = 1e-4  # a root of the polynomial with |Im t| <= ROOT_IMAG (1 + |t|) is a candidate (then verified)
-SINGULAR = 1e-7  # [rad] ψ_5 this close to 0 or π is taken as there (rounding puts it 1e-8 off at best)
 CONTINUUM = 1e-6  # a verified solution this close to axes 4 and 6 in line is one of their continuum
-DOUBLE = 1e-14  # u_x² + u_y² = p_x² + p_y² within this (relative): one sign, not two
-FLAT = 1e-9  # relative size below which a length, a twist's sine or a coefficient counts as zero
 
 
 # the continua apair_ik_wrist flags, by bit
@@ -44,10 +41,6 @@ FLAGS = {
     2: "joint 1: the wrist point on axis 1",
     4: "joint 2: the wrist point on axis 2",
 }
-
-
-def _note(free: set[str]) -> str:
-    return f"a continuum of solutions ({', '.join(sorted(free))}): one member is given" if free else ""
 
 
 def applies(chain, family: Classification) -> bool:
@@ -65,23 +58,6 @@ def applies(chain, family: Classification) -> bool:
 def _rotation(alpha: float, psi: float) -> NDArray[np.float64]:
     """Rz(ψ)·Rx(α): the rotation of one DH joint (apair.frames.dh_matrix's)."""
     return dh_matrix(0.0, alpha, 0.0, psi)[:3, :3]
-
-
-def _real_roots(coeffs: NDArray[np.float64], ref: float) -> tuple[list[float], bool]:
-    """Real roots t of Σ c_k t^k (lowest degree first), near-real ones included, and whether the
-    degree drops (a root at t = ∞, ψ_3 = π). Raises ValueError where every coefficient vanishes
-    against `ref`, the size of its terms (ψ_3 then moves nothing the polynomial sees)."""
-    size = float(np.max(np.abs(coeffs)))
-    if not size > FLAT * ref:
-        raise ValueError("the position polynomial vanishes identically")
-    c = coeffs / size
-    nz = np.nonzero(np.abs(c) > FLAT)[0]
-    top = int(nz[-1])
-    at_infinity = top < len(c) - 1
-    if top == 0:
-        return [], at_infinity
-    roots = np.roots(c[: top + 1][::-1])
-    return [float(t.real) for t in roots if abs(t.imag) <= ROOT_IMAG * (1 + abs(t))], at_infinity
 
 
 class Wrist:
@@ -109,12 +85,12 @@ class Wrist:
             cands, free = self.candidates(Tm)
             q, err = refine(self.chain, cands, Tm, tol, self.scale)
             q, err, member = self._canonical(q, err, Tm, tol)
-            return q, err, len(cands), _note(free | member)
+            return q, err, len(cands), note(free | member)
         q, err, found, cands, flags = native.ik_wrist(self.dh, self.scale, Tm.reshape(1, 4, 4), tol)
         if flags[0] < 0:
             raise ValueError("the position polynomial vanishes identically")
         k = int(found[0])
-        return q[0, :k], err[0, :k], int(cands[0]), _note({why for bit, why in FLAGS.items() if flags[0] & bit})
+        return q[0, :k], err[0, :k], int(cands[0]), note({why for bit, why in FLAGS.items() if flags[0] & bit})
 
     def _canonical(self, q, err, Tm, tol) -> tuple[NDArray[np.float64], NDArray[np.float64], set[str]]:
         """A solution with axes 4 and 6 in line (K = Rx(α_4) Rz(ψ_5) Rx(α_5) keeps e_z, K_33 = s = ±1)
@@ -143,7 +119,7 @@ class Wrist:
         r, h = float(rh[0]), float(rh[1])
         big = r + self.scale**2  # the size of the terms: r, |p|², a_1² (and h², squared in the quartic)
         ref = {"quartic": big * big, "qa": big, "qb": math.sqrt(big)}[self.case]
-        roots, at_infinity = _real_roots({"quartic": quartic, "qa": qa, "qb": qb}[self.case], ref)
+        roots, at_infinity = real_roots({"quartic": quartic, "qa": qa, "qb": qb}[self.case], ref)
         psi3s = [2 * math.atan(t) for t in roots] + ([math.pi] if at_infinity else [])
         out: list[list[float]] = []
         free: set[str] = set()

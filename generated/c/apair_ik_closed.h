@@ -1,0 +1,232 @@
+/*
+ * A copy of src/csrc/apair_ik_closed.h (hand-written), made by codegen/backends/c for the library in
+ * generated/c. Do not edit: edit src/csrc/apair_ik_closed.h. Content hash: 323c6b78aa557eed
+ */
+/*
+ * Private to the closed-form solvers of six-joint R-chains (apair_ik_wrist.c, apair_ik_parallel.c;
+ * their Python twins share apair.ik.closed): the real roots of their univariate polynomials, the DH
+ * joint transform, fk with the pose error, the Gauss-Newton polish, and the merged, sorted set of
+ * verified solutions. Static functions: each solver's file gets its own copy to inline.
+ */
+#ifndef APAIR_IK_CLOSED_H
+#define APAIR_IK_CLOSED_H
+
+#include "apair_ik_internal.h"
+
+#define CLOSED_FLAT 1e-9      /* a length (relative to the scale), a sine or a coefficient this small is zero */
+#define CLOSED_SINGULAR 1e-7  /* an angle this close to 0 or pi (at a double root) is taken as there */
+#define CLOSED_DOUBLE 1e-14   /* a squared sine within this (relative) of 0: one root, not two */
+#define CLOSED_TANGENT 1e-8  /* a local extremum of the polynomial this close to 0 (relative) is a root */
+#define CLOSED_INV_MAX 1024
+#define CLOSED_PI 3.14159265358979323846
+#define CLOSED_ROOTS 16 /* room for closed_real_roots' answer: 3 for d = 2, at most 2 n(d - 1) + 1 above: 15 for d = 4 */
+#define CLOSED_MAX 8    /* the most solutions kept per pose (a 6R chain of these families has at most 8) */
+
+GAUSS_SOLVE(closed_solve6, double, fabs)
+
+/* fk6 and jacobian6 with their invariants for one design (all joints R-pairs) */
+typedef struct {
+    const apair_kernel *fk, *jac;
+    double inv_fk[CLOSED_INV_MAX], inv_jac[CLOSED_INV_MAX];
+    double turning[6];
+} closed_fk;
+
+/* 0, or -1 where the kernels are missing or too big for the buffers */
+static int closed_fk_init(closed_fk *k, const double *dh)
+{
+    k->fk = apair_find_kernel("fk6");
+    k->jac = apair_find_kernel("jacobian6");
+    if (!k->fk || !k->jac || k->fk->n_invariants > CLOSED_INV_MAX || k->jac->n_invariants > CLOSED_INV_MAX) return -1;
+    for (int i = 0; i < 6; i++) k->turning[i] = 1.0;
+    const double *in[3] = {NULL, dh, k->turning};
+    if (k->fk->n_invariants) k->fk->invariants(in, k->inv_fk);
+    if (k->jac->n_invariants) k->jac->invariants(in, k->inv_jac);
+    return 0;
+}
+
+static double closed_horner(int d, const double *c, double x)
+{
+    double s = c[d];
+    for (int k = d - 1; k >= 0; k--) s = s * x + c[k];
+    return s;
+}
+
+static double closed_magnitude(int d, const double *c, double x)
+{
+    double s = 0.0, ax = fabs(x), p = 1.0;
+    for (int k = 0; k <= d; k++, p *= ax) s += fabs(c[k]) * p;
+    return s;
+}
+
+/* The real roots of sum c_k x^k (degree d <= 4, c[d] != 0, coefficients of size about 1): a root
+ * in each interval between the real roots of the derivative where the sign changes, and each
+ * critical point within CLOSED_TANGENT of zero (a double root, or two roots too close to
+ * separate): candidates, some repeated, at most 3 for d = 2 and 15 for d = 4. */
+static int closed_real_roots(int d, const double *c, double *roots)
+{
+    if (d <= 0) return 0;
+    if (d == 1) { roots[0] = -c[0] / c[1]; return 1; }
+    if (d == 2) { /* the stable formula; a discriminant within CLOSED_TANGENT of 0: the double root too (the
+                   * critical point, exact where the two roots are sqrt(eps) off it) */
+        double disc = c[1] * c[1] - 4 * c[2] * c[0], near = fabs(disc) <= CLOSED_TANGENT * (c[1] * c[1] + fabs(4 * c[2] * c[0]) + c[2] * c[2]);
+        int n = 0;
+        if (disc >= 0) {
+            double qq = -0.5 * (c[1] + copysign(sqrt(disc), c[1]));
+            double r1 = qq / c[2], r2 = qq != 0.0 ? c[0] / qq : -r1;
+            roots[n++] = fmin(r1, r2);
+            roots[n++] = fmax(r1, r2);
+        }
+        if (near) roots[n++] = -c[1] / (2 * c[2]);
+        return n;
+    }
+    double dc[4], crit[CLOSED_ROOTS];
+    for (int k = 1; k <= d; k++) dc[k - 1] = k * c[k];
+    int nc = closed_real_roots(d - 1, dc, crit);
+    double bound = 0.0;
+    for (int k = 0; k < d; k++) bound = fmax(bound, fabs(c[k] / c[d]));
+    bound += 1.0;
+    double ends[CLOSED_ROOTS + 2];
+    int ne = 0;
+    ends[ne++] = -bound;
+    for (int k = 0; k < nc; k++) ends[ne++] = fmin(fmax(crit[k], -bound), bound);
+    ends[ne++] = bound;
+    int n = 0;
+    for (int k = 0; k + 1 < ne; k++) {
+        double lo = ends[k], hi = ends[k + 1], flo = closed_horner(d, c, lo), fhi = closed_horner(d, c, hi);
+        if (k > 0 && fabs(flo) <= CLOSED_TANGENT * fmax(1.0, closed_magnitude(d, c, lo))) roots[n++] = lo; /* at a critical point */
+        if (flo == 0.0) continue;
+        if ((flo < 0) == (fhi < 0)) continue;
+        /* Newton's method from the secant point, kept inside the bracket (a bisection step where it
+         * would leave it), to 1e-14 relative: the candidates are polished on fk afterwards */
+        double x = lo - flo * (hi - lo) / (fhi - flo);
+        if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+        for (int it = 0; it < 100; it++) {
+            double f = c[d], df = 0.0;
+            for (int k = d - 1; k >= 0; k--) { df = df * x + f; f = f * x + c[k]; }
+            if (f == 0.0) break;
+            if ((f < 0) == (flo < 0)) lo = x; else hi = x;
+            double next = x - f / df;
+            if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+            if (fabs(next - x) <= 1e-14 * fmax(1.0, fabs(x)) || hi - lo <= 1e-14 * fmax(1.0, fabs(lo))) { x = next; break; }
+            x = next;
+        }
+        roots[n++] = x;
+    }
+    return n;
+}
+
+static void closed_dh4(double a, double ca, double sa, double c, double psi, double *A) /* Rz(psi) Tz(c) Tx(a) Rx(alpha), 3 x 4 */
+{
+    double ct = cos(psi), st = sin(psi);
+    double m[12] = {ct, -st * ca, st * sa, a * ct, st, ct * ca, -ct * sa, a * st, 0.0, sa, ca, c};
+    memcpy(A, m, sizeof m);
+}
+
+static void closed_mul34(const double *A, const double *B, double *C) /* rigid 3 x 4 products */
+{
+    double t[12];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 4; k++)
+            t[4 * r + k] = A[4 * r] * B[k] + A[4 * r + 1] * B[4 + k] + A[4 * r + 2] * B[8 + k] + (k == 3 ? A[4 * r + 3] : 0.0);
+    memcpy(C, t, sizeof t);
+}
+
+static double closed_wrap(double x) /* into (-pi, pi], as apair.ik.poses.wrap */
+{
+    return x - 2 * CLOSED_PI * ceil((x - CLOSED_PI) / (2 * CLOSED_PI));
+}
+
+/* fk and (if J) the Jacobian (6 x 6) at joint angles q; the pose error e as apair.ik.poses:
+ * [(t_T - t) / scale; rotation]; returns the largest entry of |fk - T|, translations / scale. */
+static double closed_evaluate(const closed_fk *w, const double *dh, double scale, const double *q, const double *Tt,
+                       double *e, double *J)
+{
+    double law[30], T[16];
+    for (int i = 0; i < 6; i++) {
+        law[5 * i] = cos(0.5 * q[i]);
+        law[5 * i + 1] = sin(0.5 * q[i]);
+        law[5 * i + 2] = law[5 * i + 3] = law[5 * i + 4] = 0.0;
+    }
+    const double *in[3] = {law, dh, w->turning};
+    double *outT[1] = {T};
+    if (w->fk->n_invariants) w->fk->core(w->inv_fk, in, outT); else w->fk->eval(in, outT);
+    if (J) {
+        double *outJ[1] = {J};
+        if (w->jac->n_invariants) w->jac->core(w->inv_jac, in, outJ); else w->jac->eval(in, outJ);
+    }
+    double worst = 0.0;
+    for (int k = 0; k < 12; k++) {
+        double d = fabs(T[k] - Tt[k]) / (k % 4 == 3 ? scale : 1.0);
+        if (d > worst) worst = d;
+    }
+    for (int r = 0; r < 3; r++) e[r] = (Tt[4 * r + 3] - T[4 * r + 3]) / scale;
+    double S[9];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) S[3 * r + k] = Tt[4 * r] * T[4 * k] + Tt[4 * r + 1] * T[4 * k + 1] + Tt[4 * r + 2] * T[4 * k + 2];
+    e[3] = 0.5 * (S[7] - S[5]);
+    e[4] = 0.5 * (S[2] - S[6]);
+    e[5] = 0.5 * (S[3] - S[1]);
+    return isfinite(worst) ? worst : INFINITY;
+}
+
+/* Up to two Gauss-Newton steps (as apair.ik.poses.refine); the error of the result. */
+static double closed_polish(const closed_fk *w, const double *dh, double scale, const double *Tt, double tol, double *q)
+{
+    double e[6], J[36];
+    double err = closed_evaluate(w, dh, scale, q, Tt, e, NULL);
+    if (err > 1e-3 * tol) closed_evaluate(w, dh, scale, q, Tt, e, J); /* the Jacobian only where a step is taken */
+    for (int step = 0; step < 2 && err > 1e-3 * tol; step++) {
+        double A[36], x[6], trial[6], e2[6], J2[36];
+        for (int r = 0; r < 6; r++)
+            for (int k = 0; k < 6; k++) A[6 * r + k] = J[6 * r + k] / (r < 3 ? scale : 1.0);
+        memcpy(x, e, sizeof x);
+        if (closed_solve6(6, A, 1, x)) break;
+        for (int i = 0; i < 6; i++) trial[i] = q[i] + x[i];
+        double err2 = closed_evaluate(w, dh, scale, trial, Tt, e2, J2);
+        if (!(err2 < err)) break;
+        memcpy(q, trial, sizeof trial);
+        memcpy(e, e2, sizeof e);
+        memcpy(J, J2, sizeof J);
+        err = err2;
+    }
+    return err;
+}
+
+static int closed_same_angles(const double *a, const double *b)
+{
+    for (int i = 0; i < 6; i++)
+        if (fabs(closed_wrap(a[i] - b[i])) >= 1e-6) return 0;
+    return 1;
+}
+
+/* x (verified, error err) into the solutions of one pose: a duplicate of one kept (closed_same_angles)
+ * replaces it where its error is smaller; at most CLOSED_MAX kept */
+static void closed_keep(double *q, double *error, int *found, const double *x, double err)
+{
+    for (int k = 0; k < *found; k++)
+        if (closed_same_angles(q + 6 * k, x)) {
+            if (err < error[k]) { memcpy(q + 6 * k, x, 6 * sizeof *x); error[k] = err; }
+            return;
+        }
+    if (*found < CLOSED_MAX) {
+        memcpy(q + 6 * *found, x, 6 * sizeof *x);
+        error[(*found)++] = err;
+    }
+}
+
+/* the solutions of one pose ascending by joint 1, then 2, ... (apair.ik.poses.refine's order) */
+static void closed_sort(double *qj, double *ej, int found)
+{
+    for (int a = 1; a < found; a++)
+        for (int b = a; b > 0; b--) {
+            double *u = qj + 6 * (b - 1), *v = qj + 6 * b;
+            int k = 0;
+            while (k < 6 && u[k] == v[k]) k++;
+            if (k == 6 || u[k] < v[k]) break;
+            double t[6], te = ej[b - 1];
+            memcpy(t, u, sizeof t); memcpy(u, v, sizeof t); memcpy(v, t, sizeof t);
+            ej[b - 1] = ej[b]; ej[b] = te;
+        }
+}
+
+#endif

@@ -1,0 +1,44 @@
+"""What the closed-form solvers of six-joint R-chains share (apair.ik.wrist, apair.ik.parallel): the
+tolerances, the real roots of their univariate polynomials and the note that names a continuum.
+Their C twins share src/csrc/apair_ik_closed.h."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+ROOT_IMAG = 1e-4  # a root with |Im t| <= ROOT_IMAG (1 + |t|) is a candidate (then verified)
+SINGULAR = 1e-7  # [rad] an angle this close to 0 or π (at a double root) is taken as there
+FLAT = 1e-9  # relative size below which a length, a twist's sine or a coefficient counts as zero
+DOUBLE = 1e-14  # a squared sine within this (relative) of 0: one root, not two
+TANGENT = 1e-8  # a critical point where the polynomial is this close to 0 (relative) is a (double) root
+
+
+def real_roots(coeffs: NDArray[np.float64], ref: float) -> tuple[list[float], bool]:
+    """Real roots t of Σ c_k t^k (lowest degree first), near-real ones included, and whether the
+    degree drops (a root at t = ∞, the angle π). Raises ValueError where every coefficient vanishes
+    against `ref`, the size of its terms (the angle then moves nothing the polynomial sees)."""
+    size = float(np.max(np.abs(coeffs)))
+    if not size > FLAT * ref:
+        raise ValueError("the position polynomial vanishes identically")
+    c = coeffs / size
+    nz = np.nonzero(np.abs(c) > FLAT)[0]
+    top = int(nz[-1])
+    at_infinity = top < len(c) - 1
+    if top == 0:
+        return [], at_infinity
+    poly = c[: top + 1][::-1]
+    roots = [float(t.real) for t in np.roots(poly) if abs(t.imag) <= ROOT_IMAG * (1 + abs(t))]
+    # a critical point where the polynomial (nearly) vanishes: a double root, exact where the two
+    # roots come sqrt(eps) off it (as the C twin, apair_ik_closed.h)
+    for x in np.roots(np.polyder(poly)) if top > 1 else []:
+        if abs(x.imag) <= ROOT_IMAG * (1 + abs(x)):
+            x = float(x.real)
+            if abs(np.polyval(poly, x)) <= TANGENT * max(1.0, float(np.polyval(np.abs(poly), abs(x)))):
+                roots.append(x)
+    return roots, at_infinity
+
+
+def note(free: set[str]) -> str:
+    """The note of an answer with continua (FLAGS' texts): one member of each is given."""
+    return f"a continuum of solutions ({', '.join(sorted(free))}): one member is given" if free else ""
