@@ -22,8 +22,13 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 C_FILES = sorted(glob("generated/c/*.c") + glob("generated/c/*.h"))
-# the binding: the module and the kernel registry's calls, Chain, the IK marshaller; their private header
-NATIVE_SOURCES = ["src/apair/_native.c", "src/apair/_native_chain.c", "src/apair/_native_ik.c"]
+# the binding: the module and the kernel registry's calls, Chain, ClosedIK, the IK marshaller; their private header
+NATIVE_SOURCES = [
+    "src/apair/_native.c",
+    "src/apair/_native_chain.c",
+    "src/apair/_native_closed.c",
+    "src/apair/_native_ik.c",
+]
 NATIVE_HEADERS = ["src/apair/_native.h"]
 
 

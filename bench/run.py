@@ -1301,7 +1301,7 @@ def main(argv=None) -> int:
         print(f"written to {args.out}")
         return 0
     if args.ik_closed_only or not (args.derivatives_only or args.panda_only or args.native_only):
-        print("closed-form IK, spherical wrists (apair, EAIK, IK-Geo; same poses):", flush=True)
+        print("closed-form IK, spherical wrists and UR arms (apair, EAIK, IK-Geo; same poses):", flush=True)
         results["ik_closed"] = ik_closed.section(args.quick)
         results["ik_closed_targets"] = ik_closed.targets(results["ik_closed"])
         print(f"targets (closed-form IK; load average {results['ik_closed']['load_average']:.2f}):")

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 98ccb36936ce00d4
+Content hash: 6070616e24c047f7
 """

@@ -12,8 +12,9 @@
  *
  * The rest of the module is in _native_chain.c (Chain: one chain's methods in one native call) and
  * _native_ik.c (the inverse-kinematics solvers of the hand-written C, ik_*, marshalled by one
- * table-driven function, and LocalIK, ik_local's single-pose fast path); _native.h is what they
- * share.
+ * table-driven function, and LocalIK, ik_local's single-pose fast path) and _native_closed.c
+ * (ClosedIK, the single-pose fast path of ik for the chains solved in closed form); _native.h is
+ * what they share.
  */
 #define APAIR_NATIVE_MODULE /* this file calls import_array() */
 #include "_native.h"
@@ -192,7 +193,8 @@ PyMODINIT_FUNC PyInit__native(void)
 {
     PyObject *m;
     import_array();
-    if (PyType_Ready(&apair_native_chain_type) < 0 || PyType_Ready(&apair_native_local_ik_type) < 0) {
+    if (PyType_Ready(&apair_native_chain_type) < 0 || PyType_Ready(&apair_native_local_ik_type) < 0 ||
+        PyType_Ready(&apair_native_closed_ik_type) < 0) {
         return NULL;
     }
     m = PyModule_Create(&native_module);
@@ -203,7 +205,7 @@ PyMODINIT_FUNC PyInit__native(void)
         Py_DECREF(m);
         return NULL;
     }
-    if (PyModule_AddType(m, &apair_native_local_ik_type) < 0) {
+    if (PyModule_AddType(m, &apair_native_local_ik_type) < 0 || PyModule_AddType(m, &apair_native_closed_ik_type) < 0) {
         Py_DECREF(m);
         return NULL;
     }

@@ -32,10 +32,19 @@
 /* _native_chain.c: the type apair._native.Chain, and enable(flag) (whether Chain.call may evaluate) */
 extern PyTypeObject apair_native_chain_type;
 PyObject *apair_native_enable(PyObject *self, PyObject *flag);
+int apair_native_enabled(void); /* the flag enable() set */
 
 /* _native_ik.c: the module's functions ik_* (NULL-terminated), and the type apair._native.LocalIK
  * (the single-pose fast path of AChain.ik_local) */
 extern PyMethodDef apair_native_ik_methods[];
 extern PyTypeObject apair_native_local_ik_type;
+/* and the single-pose checks the fast paths share: obj a canonical float64 array of `size` doubles,
+ * shape (size,) or (4, 4) (nd), finite, copied into out (1, else 0); T clearly rigid (1, else 0) */
+int apair_native_canonical(PyObject *obj, int nd, npy_intp size, double *out);
+int apair_native_rigid(const double *T);
+
+/* _native_closed.c: the type apair._native.ClosedIK (the single-pose fast path of AChain.ik for
+ * the chains solved in closed form) */
+extern PyTypeObject apair_native_closed_ik_type;
 
 #endif

@@ -557,10 +557,12 @@ PyTypeObject apair_native_chain_type = {
     .tp_new = PyType_GenericNew,
 };
 
-/* enable(flag): whether Chain.call may evaluate (the C backend is in use). */
+/* enable(flag): whether Chain.call (and ClosedIK.call) may evaluate (the C backend is in use). */
 PyObject *apair_native_enable(PyObject *self, PyObject *flag)
 {
     (void)self;
     native_enabled = PyObject_IsTrue(flag) == 1;
     Py_RETURN_NONE;
 }
+
+int apair_native_enabled(void) { return native_enabled; }

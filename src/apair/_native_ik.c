@@ -523,8 +523,9 @@ static int local_init(LocalIKObject *self, PyObject *args, PyObject *kwds)
 }
 
 /* obj as a float64 array of exactly `size` doubles of shape (size,) or (4, 4) (nd), canonical
- * (native byte order, C-contiguous, aligned, an ndarray itself), copied into out: 1, else 0. */
-static int local_canonical(PyObject *obj, int nd, npy_intp size, double *out)
+ * (native byte order, C-contiguous, aligned, an ndarray itself), copied into out: 1, else 0.
+ * (Shared with ClosedIK, _native_closed.c.) */
+int apair_native_canonical(PyObject *obj, int nd, npy_intp size, double *out)
 {
     PyArrayObject *a = (PyArrayObject *)obj;
     if (!PyArray_CheckExact(obj) || PyArray_TYPE(a) != NPY_DOUBLE || !PyArray_ISNOTSWAPPED(a) ||
@@ -542,7 +543,7 @@ static int local_canonical(PyObject *obj, int nd, npy_intp size, double *out)
 }
 
 /* Whether T (4 x 4, finite) is clearly a rigid transform by check_matrix's tests. */
-static int local_rigid(const double *T)
+int apair_native_rigid(const double *T)
 {
     const double *R[3] = {T, T + 4, T + 8};
     double det;
@@ -578,7 +579,7 @@ static PyObject *local_call(LocalIKObject *self, PyObject *const *args, Py_ssize
         PyErr_SetString(PyExc_RuntimeError, "LocalIK: not initialised");
         return NULL;
     }
-    if (!local_canonical(args[0], 2, 16, T) || !local_rigid(T) || !local_canonical(args[1], 1, n, q0) ||
+    if (!apair_native_canonical(args[0], 2, 16, T) || !apair_native_rigid(T) || !apair_native_canonical(args[1], 1, n, q0) ||
         !PyFloat_Check(args[2]) || !PyLong_Check(args[3]) || PyBool_Check(args[3])) {
         Py_RETURN_NONE;
     }

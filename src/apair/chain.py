@@ -85,6 +85,7 @@ class AChain:
 
     _ik: Solver | None = None  # the solver, made by the first ik (dropped when pickled)
     _local_ik: Any = None  # ik_local's native fast path (apair._native.LocalIK), set up by its first call
+    _ik_fast: Any = None  # ik's native fast path for a closed form (apair._native.ClosedIK), set with _ik
 
     def __init__(
         self,
@@ -207,7 +208,7 @@ class AChain:
             return self
         plain = object.__new__(AChain)  # a plain AChain even of a SpecialisedChain: no code reloaded
         plain.__dict__.update(self.__dict__)
-        plain.__dict__.update(_base_T=None, _tool_T=None, _framed=False, _ik=None, _local_ik=None)
+        plain.__dict__.update(_base_T=None, _tool_T=None, _framed=False, _ik=None, _local_ik=None, _ik_fast=None)
         plain.gravity = self._gravity.copy()
         plain._use(self._fast)
         return plain
@@ -220,8 +221,8 @@ class AChain:
     def __getstate__(self) -> dict[str, Any]:
         state = dict(self.__dict__)
         del state["_fast"], state["_call"]  # native objects: rebuilt on unpickling
-        state.pop("_local_ik", None)  # ik_local's, set up again by its first call
-        state.pop("_ik", None)  # the ik solver (it may hold the frameless chain): built again
+        for key in ("_local_ik", "_ik", "_ik_fast"):  # ik_local's and ik's solvers and fast paths: built again
+            state.pop(key, None)
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -625,8 +626,11 @@ class AChain:
         paths did not account for every solution (n = 5, 6)), `method` ("closed form", "elimination",
         "homotopy", "local search" or "reach bound"), `note` (why it is not certified, how it was at a
         singular pose, or a continuum's member given) and `family` (the chain's kinematic family).
-        It costs twice the plain answer for n ≤ 4, nothing more for n = 5, 6.
-        """
+        It costs twice the plain answer for n ≤ 4, nothing more for n = 5, 6; a closed form answers
+        a plain float64 pose with the default flags in a few µs (apair._native.ClosedIK)."""
+        if self._ik_fast is not None and full is False and within_limits is False and fix is None:  # closed forms
+            if (out := self._ik_fast.call(T, tol)) is not None:  # None: a pose the validating path must see
+                return out[0]
         from .ik import Solver
 
         tol = V.scalar("tol", tol, positive=True)
@@ -640,6 +644,7 @@ class AChain:
             )
         if self._ik is None:
             self._ik = Solver(self._dh_chain())
+            self._ik_fast = None if self._framed else self._ik.fast
         if self._framed:
             from .ik.poses import pose_matrix
 
@@ -663,13 +668,11 @@ class AChain:
     def prepare_ik(
         self, progress: Callable[[int, int], object] | None = None, refresh: bool = False, trace: bool = False
     ) -> StartSystem:
-        """n = 5, 6 or a P-pair: the design's homotopy start system (every complex solution at a generic complex
-        pose, by monodromy), from the cache or computed now and cached (`apair ik-prepare`).
-        trace: also run the trace test (apair.ik.homotopy.trace: seconds up to 48 solutions, minutes
-        and maybe no verdict for more, refused above 200), whose verdict is cached with the set and
-        becomes its `certified`.
-        Returns `apair.ik.homotopy.StartSystem` (.count, .certified, .runs, .loops, .seconds,
-        .trace)."""
+        """n = 5, 6 or a P-pair: the design's homotopy start system (every complex solution at a generic
+        complex pose, by monodromy), cached (`apair ik-prepare`). trace: also run the trace test
+        (apair.ik.homotopy.trace: seconds up to 48 solutions, minutes and maybe no verdict for more,
+        refused above 200), whose verdict is cached with the set as its `certified`. Returns
+        `apair.ik.homotopy.StartSystem` (.count, .certified, .runs, .loops, .seconds, .trace)."""
         from .ik import homotopy
 
         if not 5 <= self.n <= 6 and not (self.n < 5 and any(p.kind == "prismatic" for p in self.pairs)):
@@ -677,24 +680,21 @@ class AChain:
                 f"chain: start systems are for 5 and 6 joints (this chain has {self.n}; its ik is "
                 + ("solved by elimination)" if self.n < 5 else "solved with fix={k: value}, one joint held)")
             )
-        certify: Callable[..., StartSystem] | None = None
-        if trace:
-            from .ik.homotopy.trace import certify as trace_test
+        from .ik.homotopy import trace as trace_test
 
-            certify = trace_test
+        certify: Callable[..., StartSystem] | None = trace_test.certify if trace else None
         return homotopy.start_system(
             homotopy.Problem.of(self._dh_chain()), progress=progress, refresh=refresh, certify=certify
         )
 
     def ik_local(self, T: ArrayLike, q0: ArrayLike, tol: float = 1e-10, max_iter: int = 100) -> LocalSolution:
         """The solution nearest (in the damped least-squares sense) to each seed: Levenberg-Marquardt
-        from q0 (n,) or (..., n) to T (4, 4) or (..., 4, 4), broadcast together, every step kept
-        inside `limits`; in C on the fk and Jacobian kernels. Returns `apair.ik.LocalSolution`
-        (q, residual = largest entry of |fk(q) − T|, converged = residual ≤ tol). Any n, any pairs.
-        One float64 pose and seed (a controller's call) take one native call once the first call
-        has set the chain's fast path up (apair.ik.local.local_solver); the same numbers. With base
-        or tool frames T is the tool's pose in the world, solved for base⁻¹·T·tool⁻¹ (the residual
-        is measured there)."""
+        from q0 (n,) or (..., n) to T (4, 4) or (..., 4, 4), broadcast together, every step kept inside
+        `limits`; in C on the fk and Jacobian kernels. Returns `apair.ik.LocalSolution` (q, residual =
+        largest entry of |fk(q) − T|, converged = residual ≤ tol). Any n, any pairs. One float64 pose
+        and seed take one native call once the first call has set the chain's fast path up
+        (apair.ik.local.local_solver); the same numbers. With base or tool frames T is the tool's pose
+        in the world, solved for base⁻¹·T·tool⁻¹ (the residual is measured there)."""
         if self._local_ik is not None:
             out: LocalSolution | None = self._local_ik.call(T, q0, tol, max_iter)
             if out is not None:

@@ -16,9 +16,9 @@
 #define CLOSED_INV_MAX 1024
 #define CLOSED_PI 3.14159265358979323846
 #define CLOSED_ROOTS 16 /* room for closed_real_roots' answer: 3 for d = 2, at most 2 n(d - 1) + 1 above: 15 for d = 4 */
-#define CLOSED_MAX 8    /* the most solutions kept per pose (a 6R chain of these families has at most 8) */
 
 GAUSS_SOLVE(closed_solve6, double, fabs)
+
 
 /* fk6 and jacobian6 with their invariants for one design (all joints R-pairs) */
 typedef struct {
@@ -108,6 +108,24 @@ static int closed_real_roots(int d, const double *c, double *roots)
         }
         roots[n++] = x;
     }
+    return n;
+}
+
+/* The angles psi = 2 atan t of the real roots t of sum c_k t^k (degree deg <= 4; psi = pi where the
+ * degree drops: the root at t = infinity) into psi (room for CLOSED_ROOTS + 1): their count, or -1
+ * where every coefficient is below CLOSED_FLAT ref, the size of its terms (psi then moves nothing
+ * the polynomial sees: not separated). */
+static int closed_half_angles(int deg, const double *c, double ref, double *psi)
+{
+    double size = 0.0, cn[5], roots[CLOSED_ROOTS];
+    for (int k = 0; k <= deg; k++) size = fmax(size, fabs(c[k]));
+    if (!(size > CLOSED_FLAT * ref)) return -1;
+    for (int k = 0; k <= deg; k++) cn[k] = c[k] / size;
+    int top = deg;
+    while (top > 0 && fabs(cn[top]) <= CLOSED_FLAT) top--;
+    int n = closed_real_roots(top, cn, roots);
+    for (int k = 0; k < n; k++) psi[k] = 2 * atan(roots[k]);
+    if (top < deg) psi[n++] = CLOSED_PI;
     return n;
 }
 

@@ -1,6 +1,7 @@
 /*
  * Private to the hand-written solvers of src/csrc (apair_ik_*.c, apair_ik4.c, apair_ik6r.c): the
- * complex type in C and C++, and the Gaussian elimination they share (GAUSS_SOLVE). Not part of
+ * complex type in C and C++, the Gaussian elimination they share (GAUSS_SOLVE), and the entry
+ * points of the closed forms behind apair_ik_closed (apair_ik_closed.c). Not part of
  * the API (not installed; apair.h declares the solvers themselves).
  */
 #ifndef APAIR_IK_INTERNAL_H
@@ -32,6 +33,20 @@ typedef double _Complex cplx;
 #include "apair_internal.h"
 
 #define NMAX 6 /* the most joints of a chain */
+
+/* The closed forms of six R-pairs (apair_ik_wrist.c, apair_ik_parallel.c; their shared steps in
+ * apair_ik_closed.h). */
+#define CLOSED_MAX 8 /* the most solutions kept per pose (a 6R chain of these families has at most 8) */
+/* Each closed form's design read once into `design` (apair_ik_closed's storage; 0, or -1 where the
+ * form does not apply) and its solutions at one pose T (4 x 4 row-major): q (8 x 6, the first
+ * *found rows set), error (8), and the candidates and flags of apair_ik_wrist, apair_ik_parallel.
+ * apair_ik_closed_init and apair_ik_closed_solve (apair_ik_closed.c) call them. */
+int apair_ik_wrist_prepare(void *design, const double *dh, double scale);
+void apair_ik_wrist_solve1(const void *design, const double *T, double tol, double *q, double *error, int *found,
+                           int *candidates, int *flags);
+int apair_ik_parallel_prepare(void *design, const double *dh, double scale);
+void apair_ik_parallel_solve1(const void *design, const double *T, double tol, double *q, double *error, int *found,
+                              int *candidates, int *flags);
 
 /* GAUSS_SOLVE(name, T, mag) defines `static int name(int n, T *A, int m, T *B)` for the scalar
  * type T (mag: its absolute value). It solves A X = B (A n x n, row-major, overwritten; B n x m,

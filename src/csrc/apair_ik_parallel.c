@@ -13,7 +13,7 @@
 typedef struct {
     closed_fk k;
     int which; /* 0: the quartic; 1: L_2's quadratic (Q = 0, a_5 = 0); 2: L_1's (P = 0, axes 5 and 6 parallel) */
-    double P, Q, ca[6], sa[6], phi[6], o3[3];
+    double dh[24], scale, eps, P, Q, ca[6], sa[6], phi[6], o3[3];
     double inv_pos[CLOSED_INV_MAX];
 } parallel_design;
 
@@ -119,74 +119,80 @@ static int inner(const parallel_design *p, const double *dh, double scale, const
     return n;
 }
 
+/* the prepared design lives in apair_ik_closed's storage */
+typedef char parallel_design_fits[sizeof(parallel_design) <= sizeof(((apair_ik_closed *)0)->design) ? 1 : -1];
+
+int apair_ik_parallel_prepare(void *design, const double *dh, double scale)
+{
+    parallel_design *p = (parallel_design *)design;
+    if (closed_fk_init(&p->k, dh) || !(scale > 0) || APAIR_IK_PARALLEL_POSITION6_INVARIANTS > CLOSED_INV_MAX) return -1;
+    memcpy(p->dh, dh, sizeof p->dh);
+    p->scale = scale;
+    apair_ik_parallel_position6_invariants(dh, p->inv_pos);
+    for (int i = 0; i < 6; i++) { p->ca[i] = cos(dh[4 * i + 1]); p->sa[i] = sin(dh[4 * i + 1]); p->phi[i] = dh[4 * i + 3]; }
+    p->eps = p->ca[1] * p->ca[2];
+    p->P = -p->eps * p->sa[3] * p->sa[4];
+    p->Q = p->eps * p->sa[3] * dh[16];
+    int p0 = fabs(p->P) <= CLOSED_FLAT, q0 = fabs(p->Q) <= CLOSED_FLAT * scale;
+    /* axes 2, 3, 4 not parallel, or axes 5 and 6 one line: not this closed form */
+    if (fabs(p->sa[1]) > CLOSED_FLAT || fabs(p->sa[2]) > CLOSED_FLAT || (p0 && q0)) return -1;
+    p->which = q0 ? 1 : p0 ? 2 : 0;
+    p->o3[0] = dh[12];
+    p->o3[1] = dh[14] * p->sa[3];
+    p->o3[2] = dh[14] * p->ca[3];
+    return 0;
+}
+
+void apair_ik_parallel_solve1(const void *design, const double *Tt, double tol, double *qj, double *ej, int *found,
+                              int *candidates, int *flags)
+{
+    const parallel_design *p = (const parallel_design *)design;
+    const double *dh = p->dh, eps = p->eps;
+    double scale = p->scale, L[6], PQ[2], quartic[5], qa[3], qb[3];
+    *found = *candidates = *flags = 0;
+    apair_ik_parallel_position6_core(p->inv_pos, dh, Tt, L, PQ, quartic, qa, qb);
+    const double *c = p->which == 0 ? quartic : p->which == 1 ? qb : qa;
+    int deg = p->which == 0 ? 4 : 2;
+    double big = scale + sqrt(Tt[3] * Tt[3] + Tt[7] * Tt[7] + Tt[11] * Tt[11]);
+    double ref = p->which == 0 ? (big * p->P) * (big * p->P) + p->Q * p->Q : p->which == 1 ? big : 1.0;
+    double psi1s[CLOSED_ROOTS + 1];
+    int n1 = closed_half_angles(deg, c, ref, psi1s);
+    if (n1 < 0) { *flags = -1; return; } /* the polynomial vanishes: not separated */
+    double z5[3], ca6 = p->ca[5], sa6 = p->sa[5];
+    for (int r = 0; r < 3; r++) z5[r] = Tt[4 * r + 1] * sa6 + Tt[4 * r + 2] * ca6;
+    for (int k1 = 0; k1 < n1; k1++) {
+        double c1 = cos(psi1s[k1]), s1 = sin(psi1s[k1]);
+        double l1 = L[0] + L[1] * c1 + L[2] * s1, l2 = L[3] + L[4] * c1 + L[5] * s1;
+        double z1[3] = {p->sa[0] * s1, -p->sa[0] * c1, p->ca[0]}, psi5s[2];
+        int n5 = psi5_of(p, l1, l2, z1, z5, psi5s);
+        /* v = eps z1^T R_6 Rx(alpha_6)^T: what w Rz(psi_6) must be (w: the third row of Rz(psi_5) Rx(alpha_5)) */
+        double u[3];
+        for (int k = 0; k < 3; k++) u[k] = z1[0] * Tt[k] + z1[1] * Tt[4 + k] + z1[2] * Tt[8 + k];
+        double vx = eps * u[0], vy = eps * (u[1] * ca6 - u[2] * sa6);
+        for (int k5 = 0; k5 < n5; k5++) {
+            double s5 = sin(psi5s[k5]), c5 = cos(psi5s[k5]);
+            double wx = p->sa[3] * s5, wy = p->sa[3] * c5 * p->ca[4] + p->ca[3] * p->sa[4];
+            int singular = hypot(wx, wy) <= CLOSED_SINGULAR; /* axis 6 parallel to axes 2-4: psi_6 free */
+            double psi6 = singular ? free_psi6(p, dh, Tt, psi1s[k1], psi5s[k5])
+                                   : atan2(wy * vx - wx * vy, wx * vx + wy * vy), x[12];
+            int nx = inner(p, dh, scale, Tt, psi1s[k1], psi5s[k5], psi6, x, flags);
+            for (int k = 0; k < nx; k++) {
+                (*candidates)++;
+                double err = closed_polish(&p->k, dh, scale, Tt, tol, x + 6 * k);
+                if (!(err <= tol)) continue;
+                for (int i = 0; i < 6; i++) x[6 * k + i] = closed_wrap(x[6 * k + i]);
+                closed_keep(qj, ej, found, x + 6 * k, err);
+                if (singular) *flags |= 1;
+            }
+        }
+    }
+    closed_sort(qj, ej, *found);
+}
+
 int apair_ik_parallel(const double *dh, double scale, size_t count, const double *target, ptrdiff_t target_stride,
                       double tol, double *q, double *error, int *found, int *candidates, int *flags)
 {
-    parallel_design p;
-    if (closed_fk_init(&p.k, dh) || !(scale > 0)) return -1;
-    if (APAIR_IK_PARALLEL_POSITION6_INVARIANTS > CLOSED_INV_MAX) return -1;
-    apair_ik_parallel_position6_invariants(dh, p.inv_pos);
-    for (int i = 0; i < 6; i++) { p.ca[i] = cos(dh[4 * i + 1]); p.sa[i] = sin(dh[4 * i + 1]); p.phi[i] = dh[4 * i + 3]; }
-    if (fabs(p.sa[1]) > CLOSED_FLAT || fabs(p.sa[2]) > CLOSED_FLAT) return -1; /* axes 2, 3, 4 not parallel */
-    double eps = p.ca[1] * p.ca[2];
-    p.P = -eps * p.sa[3] * p.sa[4];
-    p.Q = eps * p.sa[3] * dh[16];
-    int p0 = fabs(p.P) <= CLOSED_FLAT, q0 = fabs(p.Q) <= CLOSED_FLAT * scale;
-    if (p0 && q0) return -1; /* axes 5 and 6 one line */
-    p.which = q0 ? 1 : p0 ? 2 : 0;
-    p.o3[0] = dh[12];
-    p.o3[1] = dh[14] * p.sa[3];
-    p.o3[2] = dh[14] * p.ca[3];
-    for (size_t j = 0; j < count; j++) {
-        const double *Tt = target + (ptrdiff_t)j * target_stride;
-        double *qj = q + 6 * CLOSED_MAX * j, *ej = error + CLOSED_MAX * j;
-        double L[6], PQ[2], quartic[5], qa[3], qb[3];
-        found[j] = candidates[j] = flags[j] = 0;
-        apair_ik_parallel_position6_core(p.inv_pos, dh, Tt, L, PQ, quartic, qa, qb);
-        const double *c = p.which == 0 ? quartic : p.which == 1 ? qb : qa;
-        int deg = p.which == 0 ? 4 : 2;
-        double big = scale + sqrt(Tt[3] * Tt[3] + Tt[7] * Tt[7] + Tt[11] * Tt[11]);
-        double ref = p.which == 0 ? (big * p.P) * (big * p.P) + p.Q * p.Q : p.which == 1 ? big : 1.0;
-        double size = 0.0;
-        for (int k = 0; k <= deg; k++) size = fmax(size, fabs(c[k]));
-        if (!(size > CLOSED_FLAT * ref)) { flags[j] = -1; continue; } /* the polynomial vanishes: not separated */
-        double cn[5];
-        for (int k = 0; k <= deg; k++) cn[k] = c[k] / size;
-        int top = deg;
-        while (top > 0 && fabs(cn[top]) <= CLOSED_FLAT) top--;
-        double psi1s[CLOSED_ROOTS + 1], roots[CLOSED_ROOTS];
-        int n1 = closed_real_roots(top, cn, roots);
-        for (int k = 0; k < n1; k++) psi1s[k] = 2 * atan(roots[k]);
-        if (top < deg) psi1s[n1++] = CLOSED_PI;
-        double z5[3], ca6 = p.ca[5], sa6 = p.sa[5];
-        for (int r = 0; r < 3; r++) z5[r] = Tt[4 * r + 1] * sa6 + Tt[4 * r + 2] * ca6;
-        for (int k1 = 0; k1 < n1; k1++) {
-            double c1 = cos(psi1s[k1]), s1 = sin(psi1s[k1]);
-            double l1 = L[0] + L[1] * c1 + L[2] * s1, l2 = L[3] + L[4] * c1 + L[5] * s1;
-            double z1[3] = {p.sa[0] * s1, -p.sa[0] * c1, p.ca[0]}, psi5s[2];
-            int n5 = psi5_of(&p, l1, l2, z1, z5, psi5s);
-            /* v = eps z1^T R_6 Rx(alpha_6)^T: what w Rz(psi_6) must be (w: the third row of Rz(psi_5) Rx(alpha_5)) */
-            double u[3];
-            for (int k = 0; k < 3; k++) u[k] = z1[0] * Tt[k] + z1[1] * Tt[4 + k] + z1[2] * Tt[8 + k];
-            double vx = eps * u[0], vy = eps * (u[1] * ca6 - u[2] * sa6);
-            for (int k5 = 0; k5 < n5; k5++) {
-                double s5 = sin(psi5s[k5]), c5 = cos(psi5s[k5]);
-                double wx = p.sa[3] * s5, wy = p.sa[3] * c5 * p.ca[4] + p.ca[3] * p.sa[4];
-                int singular = hypot(wx, wy) <= CLOSED_SINGULAR; /* axis 6 parallel to axes 2-4: psi_6 free */
-                double psi6 = singular ? free_psi6(&p, dh, Tt, psi1s[k1], psi5s[k5])
-                                       : atan2(wy * vx - wx * vy, wx * vx + wy * vy), x[12];
-                int nx = inner(&p, dh, scale, Tt, psi1s[k1], psi5s[k5], psi6, x, &flags[j]);
-                for (int k = 0; k < nx; k++) {
-                    candidates[j]++;
-                    double err = closed_polish(&p.k, dh, scale, Tt, tol, x + 6 * k);
-                    if (!(err <= tol)) continue;
-                    for (int i = 0; i < 6; i++) x[6 * k + i] = closed_wrap(x[6 * k + i]);
-                    closed_keep(qj, ej, &found[j], x + 6 * k, err);
-                    if (singular) flags[j] |= 1;
-                }
-            }
-        }
-        closed_sort(qj, ej, found[j]);
-    }
-    return 0;
+    apair_ik_closed solver;
+    if (apair_ik_closed_init(&solver, APAIR_IK_PARALLEL, dh, scale)) return -1;
+    return apair_ik_closed_solve(&solver, count, target, target_stride, tol, q, error, found, candidates, flags);
 }

@@ -15,6 +15,7 @@
 
 typedef struct {
     closed_fk k;
+    double dh[24], scale, ca6, sa6;
     int which;               /* 0: quartic; 1: (A), a_1 = 0; 2: (B), sin alpha_1 = 0 */
     double a1, ca1, sa1, B2[12], m3[3], ca4, sa4, ca5, sa5, alpha[6], phi[6], ca[6], sa[6];
     double inv_pos[CLOSED_INV_MAX];
@@ -111,84 +112,89 @@ static double canonical_wrist(const wrist_design *w, const double *dh, double sc
     return err2;
 }
 
+/* the prepared design lives in apair_ik_closed's storage */
+typedef char wrist_design_fits[sizeof(wrist_design) <= sizeof(((apair_ik_closed *)0)->design) ? 1 : -1];
+
+int apair_ik_wrist_prepare(void *design, const double *dh, double scale)
+{
+    wrist_design *w = (wrist_design *)design;
+    if (closed_fk_init(&w->k, dh) || !(scale > 0) || APAIR_IK_WRIST_POSITION6_INVARIANTS > CLOSED_INV_MAX) return -1;
+    memcpy(w->dh, dh, sizeof w->dh);
+    w->scale = scale;
+    for (int i = 0; i < 6; i++) { w->alpha[i] = dh[4 * i + 1]; w->phi[i] = dh[4 * i + 3]; }
+    apair_ik_wrist_position6_invariants(dh, w->inv_pos);
+    w->a1 = dh[0]; w->ca1 = cos(dh[1]); w->sa1 = sin(dh[1]);
+    w->which = fabs(w->a1) <= CLOSED_FLAT * scale ? 1 : fabs(w->sa1) <= CLOSED_FLAT ? 2 : 0;
+    for (int i = 0; i < 6; i++) { w->ca[i] = cos(dh[4 * i + 1]); w->sa[i] = sin(dh[4 * i + 1]); }
+    closed_dh4(dh[4], w->ca[1], w->sa[1], dh[6], 0.0, w->B2);
+    {
+        double A3[12];
+        closed_dh4(dh[8], w->ca[2], w->sa[2], dh[10], 0.0, A3);
+        for (int r = 0; r < 3; r++) w->m3[r] = A3[4 * r + 2] * dh[14] + A3[4 * r + 3];
+    }
+    w->ca4 = cos(dh[13]); w->sa4 = sin(dh[13]); w->ca5 = cos(dh[17]); w->sa5 = sin(dh[17]);
+    w->ca6 = cos(dh[21]);
+    w->sa6 = sin(dh[21]);
+    return fabs(w->sa4 * w->sa5) <= CLOSED_FLAT ? -1 : 0; /* not a wrist: axes 4, 5 or 5, 6 parallel */
+}
+
+void apair_ik_wrist_solve1(const void *design, const double *Tt, double tol, double *qj, double *ej, int *found,
+                           int *candidates, int *flags)
+{
+    const wrist_design *w = (const wrist_design *)design;
+    double W[3], rh[2], quartic[5], qa[3], qb[3];
+    *found = *candidates = *flags = 0;
+    apair_ik_wrist_position6_core(w->inv_pos, w->dh, Tt, W, rh, quartic, qa, qb);
+    const double *c = w->which == 0 ? quartic : w->which == 1 ? qa : qb;
+    int deg = w->which == 0 ? 4 : 2;
+    double big = rh[0] + w->scale * w->scale, ref = w->which == 0 ? big * big : w->which == 1 ? big : sqrt(big);
+    double psi3[CLOSED_ROOTS + 1];
+    int n3 = closed_half_angles(deg, c, ref, psi3);
+    if (n3 < 0) { *flags = -1; return; } /* the polynomial vanishes: not separated */
+    double R6[9] = {Tt[0], Tt[1], Tt[2], Tt[4], Tt[5], Tt[6], Tt[8], Tt[9], Tt[10]};
+    for (int k3 = 0; k3 < n3; k3++) {
+        double c3 = cos(psi3[k3]), s3 = sin(psi3[k3]);
+        double m[3] = {c3 * w->m3[0] - s3 * w->m3[1], s3 * w->m3[0] + c3 * w->m3[1], w->m3[2]}, p[3];
+        for (int r = 0; r < 3; r++) p[r] = w->B2[4 * r] * m[0] + w->B2[4 * r + 1] * m[1] + w->B2[4 * r + 2] * m[2] + w->B2[4 * r + 3];
+        double psi12[4];
+        int n12 = shoulder(w, w->scale, W, rh[0], rh[1], p, psi12, flags);
+        for (int k12 = 0; k12 < n12; k12++) {
+            double A1[12], A2[12], A3[12], A[12], M[9], R6x[9];
+            closed_dh4(w->dh[0], w->ca[0], w->sa[0], w->dh[2], psi12[2 * k12], A1);
+            closed_dh4(w->dh[4], w->ca[1], w->sa[1], w->dh[6], psi12[2 * k12 + 1], A2);
+            closed_dh4(w->dh[8], w->ca[2], w->sa[2], w->dh[10], psi3[k3], A3);
+            closed_mul34(A1, A2, A);
+            closed_mul34(A, A3, A);
+            /* R6 Rx(alpha_6)^T, then M = R_3^T (R6 Rx^T) */
+            for (int r = 0; r < 3; r++) {
+                R6x[3 * r] = R6[3 * r];
+                R6x[3 * r + 1] = R6[3 * r + 1] * w->ca6 - R6[3 * r + 2] * w->sa6;
+                R6x[3 * r + 2] = R6[3 * r + 1] * w->sa6 + R6[3 * r + 2] * w->ca6;
+            }
+            for (int r = 0; r < 3; r++)
+                for (int k = 0; k < 3; k++) M[3 * r + k] = A[r] * R6x[k] + A[4 + r] * R6x[3 + k] + A[8 + r] * R6x[6 + k];
+            double psi456[6];
+            int n456 = wrist(w, M, psi456, flags);
+            for (int k456 = 0; k456 < n456; k456++) {
+                double x[6] = {psi12[2 * k12], psi12[2 * k12 + 1], psi3[k3], psi456[3 * k456], psi456[3 * k456 + 1],
+                               psi456[3 * k456 + 2]};
+                for (int i = 0; i < 6; i++) x[i] = closed_wrap(x[i] - w->phi[i]);
+                (*candidates)++;
+                double err = closed_polish(&w->k, w->dh, w->scale, Tt, tol, x);
+                if (!(err <= tol)) continue;
+                err = canonical_wrist(w, w->dh, w->scale, Tt, tol, x, err, flags);
+                for (int i = 0; i < 6; i++) x[i] = closed_wrap(x[i]);
+                closed_keep(qj, ej, found, x, err);
+            }
+        }
+    }
+    closed_sort(qj, ej, *found);
+}
+
 int apair_ik_wrist(const double *dh, double scale, size_t count, const double *target, ptrdiff_t target_stride,
                    double tol, double *q, double *error, int *found, int *candidates, int *flags)
 {
-    wrist_design w;
-    if (closed_fk_init(&w.k, dh) || !(scale > 0)) return -1;
-    for (int i = 0; i < 6; i++) { w.alpha[i] = dh[4 * i + 1]; w.phi[i] = dh[4 * i + 3]; }
-    if (APAIR_IK_WRIST_POSITION6_INVARIANTS > CLOSED_INV_MAX) return -1;
-    apair_ik_wrist_position6_invariants(dh, w.inv_pos);
-    w.a1 = dh[0]; w.ca1 = cos(dh[1]); w.sa1 = sin(dh[1]);
-    w.which = fabs(w.a1) <= CLOSED_FLAT * scale ? 1 : fabs(w.sa1) <= CLOSED_FLAT ? 2 : 0;
-    for (int i = 0; i < 6; i++) { w.ca[i] = cos(dh[4 * i + 1]); w.sa[i] = sin(dh[4 * i + 1]); }
-    closed_dh4(dh[4], w.ca[1], w.sa[1], dh[6], 0.0, w.B2);
-    {
-        double A3[12];
-        closed_dh4(dh[8], w.ca[2], w.sa[2], dh[10], 0.0, A3);
-        for (int r = 0; r < 3; r++) w.m3[r] = A3[4 * r + 2] * dh[14] + A3[4 * r + 3];
-    }
-    w.ca4 = cos(dh[13]); w.sa4 = sin(dh[13]); w.ca5 = cos(dh[17]); w.sa5 = sin(dh[17]);
-    if (fabs(w.sa4 * w.sa5) <= CLOSED_FLAT) return -1; /* not a wrist: axes 4, 5 or 5, 6 parallel */
-    double ca6 = cos(dh[21]), sa6 = sin(dh[21]);
-    for (size_t j = 0; j < count; j++) {
-        const double *Tt = target + (ptrdiff_t)j * target_stride;
-        double *qj = q + 48 * j, *ej = error + 8 * j;
-        double W[3], rh[2], quartic[5], qa[3], qb[3];
-        found[j] = candidates[j] = flags[j] = 0;
-        apair_ik_wrist_position6_core(w.inv_pos, dh, Tt, W, rh, quartic, qa, qb);
-        const double *c = w.which == 0 ? quartic : w.which == 1 ? qa : qb;
-        int deg = w.which == 0 ? 4 : 2;
-        double big = rh[0] + scale * scale, ref = w.which == 0 ? big * big : w.which == 1 ? big : sqrt(big);
-        double size = 0.0;
-        for (int k = 0; k <= deg; k++) size = fmax(size, fabs(c[k]));
-        if (!(size > CLOSED_FLAT * ref)) { flags[j] = -1; continue; } /* the polynomial vanishes: not separated */
-        double cn[5];
-        for (int k = 0; k <= deg; k++) cn[k] = c[k] / size;
-        int top = deg;
-        while (top > 0 && fabs(cn[top]) <= CLOSED_FLAT) top--;
-        double psi3[CLOSED_ROOTS + 1], roots[CLOSED_ROOTS];
-        int n3 = closed_real_roots(top, cn, roots);
-        for (int k = 0; k < n3; k++) psi3[k] = 2 * atan(roots[k]);
-        if (top < deg) psi3[n3++] = CLOSED_PI;
-        double R6[9] = {Tt[0], Tt[1], Tt[2], Tt[4], Tt[5], Tt[6], Tt[8], Tt[9], Tt[10]};
-        for (int k3 = 0; k3 < n3; k3++) {
-            double c3 = cos(psi3[k3]), s3 = sin(psi3[k3]);
-            double m[3] = {c3 * w.m3[0] - s3 * w.m3[1], s3 * w.m3[0] + c3 * w.m3[1], w.m3[2]}, p[3];
-            for (int r = 0; r < 3; r++) p[r] = w.B2[4 * r] * m[0] + w.B2[4 * r + 1] * m[1] + w.B2[4 * r + 2] * m[2] + w.B2[4 * r + 3];
-            double psi12[4];
-            int n12 = shoulder(&w, scale, W, rh[0], rh[1], p, psi12, &flags[j]);
-            for (int k12 = 0; k12 < n12; k12++) {
-                double A1[12], A2[12], A3[12], A[12], M[9], R6x[9];
-                closed_dh4(dh[0], w.ca[0], w.sa[0], dh[2], psi12[2 * k12], A1);
-                closed_dh4(dh[4], w.ca[1], w.sa[1], dh[6], psi12[2 * k12 + 1], A2);
-                closed_dh4(dh[8], w.ca[2], w.sa[2], dh[10], psi3[k3], A3);
-                closed_mul34(A1, A2, A);
-                closed_mul34(A, A3, A);
-                /* R6 Rx(alpha_6)^T, then M = R_3^T (R6 Rx^T) */
-                for (int r = 0; r < 3; r++) {
-                    R6x[3 * r] = R6[3 * r];
-                    R6x[3 * r + 1] = R6[3 * r + 1] * ca6 - R6[3 * r + 2] * sa6;
-                    R6x[3 * r + 2] = R6[3 * r + 1] * sa6 + R6[3 * r + 2] * ca6;
-                }
-                for (int r = 0; r < 3; r++)
-                    for (int k = 0; k < 3; k++) M[3 * r + k] = A[r] * R6x[k] + A[4 + r] * R6x[3 + k] + A[8 + r] * R6x[6 + k];
-                double psi456[6];
-                int n456 = wrist(&w, M, psi456, &flags[j]);
-                for (int k456 = 0; k456 < n456; k456++) {
-                    double x[6] = {psi12[2 * k12], psi12[2 * k12 + 1], psi3[k3], psi456[3 * k456], psi456[3 * k456 + 1],
-                                   psi456[3 * k456 + 2]};
-                    for (int i = 0; i < 6; i++) x[i] = closed_wrap(x[i] - w.phi[i]);
-                    candidates[j]++;
-                    double err = closed_polish(&w.k, dh, scale, Tt, tol, x);
-                    if (!(err <= tol)) continue;
-                    err = canonical_wrist(&w, dh, scale, Tt, tol, x, err, &flags[j]);
-                    for (int i = 0; i < 6; i++) x[i] = closed_wrap(x[i]);
-                    closed_keep(qj, ej, &found[j], x, err);
-                }
-            }
-        }
-        closed_sort(qj, ej, found[j]);
-    }
-    return 0;
+    apair_ik_closed solver;
+    if (apair_ik_closed_init(&solver, APAIR_IK_WRIST, dh, scale)) return -1;
+    return apair_ik_closed_solve(&solver, count, target, target_stride, tol, q, error, found, candidates, flags);
 }

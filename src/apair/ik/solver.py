@@ -20,11 +20,12 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..kernels import native_module
 from . import elimination1a5r, elimination6r, homotopy, parallel, wrist
 from .elimination4 import CAND_TOL, Elimination
 from .families import Classification, classify
@@ -143,6 +144,9 @@ class Solver:
         self.slides = np.array([p.kind == "prismatic" for p in chain.pairs])
         # the reach bound counts a P-pair's slide within its limits; its solutions are any real d
         self.reach = math.inf if self.slides.any() else reach_of(chain)
+        # the closed form's single-pose fast path in C (apair._native.ClosedIK: call(T, tol) gives what
+        # solve(T, tol) would, or None where the pose needs the validating path), or None
+        self.fast = _fast_path(self._closed, self.scale, self.reach)
         self.seed = seed
         self._eliminations: dict[bool, Elimination] = {}
         self._problem: Problem | None = None  # n = 5, 6: the homotopy.Problem
@@ -331,6 +335,17 @@ def _closed_form(chain: ChainLike, family: Classification, scale: float) -> wris
         except ValueError:  # a design the closed form does not cover (axes 5 and 6 one line)
             return None
     return None
+
+
+def _fast_path(closed: wrist.Wrist | parallel.Parallel | None, scale: float, reach: float) -> Any:
+    """apair._native.ClosedIK for the closed form, where the C extension is installed, else None."""
+    native, _ = native_module()
+    if closed is None or native is None:
+        return None
+    try:
+        return native.ClosedIK(1 if isinstance(closed, wrist.Wrist) else 2, closed.dh, scale, reach)
+    except ValueError:  # a design its C form does not prepare: the validating path answers
+        return None
 
 
 def _unaccounted(ends: Endpoints) -> str:
