@@ -91,7 +91,7 @@ class Parallel:
         L1, L2 = L.reshape(2, 3)
         P, Q = float(PQ[0]), float(PQ[1])
         big = self.scale + float(np.linalg.norm(Tm[:3, 3]))  # the size of L_2's terms
-        ref = {"quartic": (big * abs(P)) ** 2 + (Q * max(1.0, abs(P))) ** 2, "qa": 1.0, "qb": big}[self.case]
+        ref = {"quartic": (big * P) ** 2 + Q**2, "qa": 1.0, "qb": big}[self.case]  # as apair_ik_parallel.c
         roots, at_infinity = real_roots({"quartic": quartic, "qa": qa, "qb": qb}[self.case], ref)
         psi1s = [2 * math.atan(t) for t in roots] + ([math.pi] if at_infinity else [])
         z5 = Tm[:3, :3] @ np.array([0.0, self.sa[5], self.ca[5]])
