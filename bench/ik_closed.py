@@ -1,5 +1,7 @@
-"""The closed-form inverse kinematics of arms with a spherical wrist and of UR arms (three parallel
-inner axes; issue 42) against EAIK and IK-Geo, side by side on the same poses in one run
+"""The closed-form inverse kinematics of arms with a spherical wrist, of UR arms (three parallel
+inner axes) and of a design with axes 1, 2, 3 parallel and 5, 6 meeting (issue 42), two of them
+also mounted wrist-first (the family at the base end), against
+EAIK and IK-Geo, side by side on the same poses in one run
 (`bench/run.py --ik-closed-only`, and in the full run): single Python calls (apair's `chain.ik(T)`,
 EAIK's `IK(T)`, IK-Geo's `get_ik(R, t)`, interleaved pose by pose), apair's batched C call
 (`apair._native.ik_wrist` or `ik_parallel` on N poses) against
@@ -16,6 +18,7 @@ import numpy as np
 import apair
 from apair.ik.parallel import Parallel
 from apair.ik.poses import length_scale
+from apair.ik.three_parallel import ThreeParallel
 from apair.ik.wrist import Wrist
 from apair.kernels import native_module
 
@@ -49,6 +52,23 @@ ARMS = {  # standard DH (a, alpha, d), the arms of tests/ik/test_ik_wrist.py and
         [0.1807, 0, 0, 0.17415, 0.11985, 0.11655],
     ),
 }
+
+ARMS["1∥2∥3, 5∩6 design"] = (
+    [0.3, 0.25, 0.1, 0.05, 0, 0.02],
+    [0, 0, 1.1, -0.7, 0.9, 0.3],
+    [0.2, 0.05, 0.1, 0.15, 0.08, 0.1],
+)
+
+
+def _wrist_first(a, alpha, d):
+    """The arm mounted wrist-first: its reversed chain is the arm (apair.ik.reverse; a_6 = 0.05,
+    α_6 = 0.4 become that chain's base)."""
+    a, alpha, d = (np.asarray(x, float) for x in (a, alpha, d))
+    return np.append(-a[4::-1], 0.05).tolist(), np.append(-alpha[4::-1], 0.4).tolist(), (-d[::-1]).tolist()
+
+
+ARMS["PUMA560 wrist-first"] = _wrist_first(*ARMS["PUMA560"])
+ARMS["UR5 wrist-first"] = _wrist_first(*ARMS["UR5"])
 # IK-Geo's solver of each family (its names: h2∥h3∥h4 with h5∩h6 is three_parallel_two_intersecting)
 IKGEO = {"three-inner-parallel": "three_parallel_two_intersecting"}
 SAME = 1e-6
@@ -89,7 +109,13 @@ def section(quick: bool) -> dict:
     for name, (a, alpha, d) in ARMS.items():
         chain = apair.AChain([apair.APair.revolute()] * 6, a=a, alpha=alpha, offset=d)
         eaik = DhRobot(np.array(alpha, float), np.array(a, float), np.array(d, float))
-        geo = _ikgeo(eaik, chain)
+        reversed_ = bool(chain.kinematic_family().family.reversed)
+        # IK-Geo's solvers take the forward families with a wrist or 2∥3∥4
+        geo = (
+            None
+            if reversed_ or chain.kinematic_family().key == "three-parallel-two-intersecting"
+            else _ikgeo(eaik, chain)
+        )
         rng = np.random.default_rng(42)
         Ts = chain.fk(rng.uniform(-PI, PI, (count, 6)))
         chain.ik(Ts[0])
@@ -119,10 +145,12 @@ def section(quick: bool) -> dict:
             "median_us": {k: float(np.median(v) * 1e6) for k, v in times.items()},
             "eaik_solutions_missing_from_apair": missing,
         }
-        if native is not None:
-            parallel = chain.kinematic_family().key == "three-inner-parallel"
-            w = (Parallel if parallel else Wrist)(chain, length_scale(chain))
-            solve = native.ik_parallel if parallel else native.ik_wrist
+        if native is not None and not reversed_:  # (the batched C calls take the forward families)
+            make, solve = {
+                "three-inner-parallel": (Parallel, native.ik_parallel),
+                "three-parallel-two-intersecting": (ThreeParallel, native.ik_three_parallel),
+            }.get(chain.kinematic_family().key, (Wrist, native.ik_wrist))
+            w = make(chain, length_scale(chain))
             Tb = chain.fk(rng.uniform(-PI, PI, (batch, 6)))
             best = min(_timed(lambda: solve(w.dh, w.scale, Tb, 1e-9)) for _ in range(5))
             row["batched_us_per_pose"] = {"apair": best / batch * 1e6}
@@ -135,7 +163,7 @@ def section(quick: bool) -> dict:
         out["arms"][name] = row
         med = row["median_us"]
         print(
-            f"  {name:13s} {row['family']:31s} single call: apair {med['apair']:7.1f} µs, EAIK {med['eaik']:5.1f} µs"
+            f"  {name:19s} {row['family']:32s} single call: apair {med['apair']:7.1f} µs, EAIK {med['eaik']:5.1f} µs"
             + (f", IK-Geo {med['ik_geo']:5.1f} µs" if "ik_geo" in med else "")
             + (
                 "; batched µs/pose: " + ", ".join(f"{k} {v:.2f}" for k, v in row["batched_us_per_pose"].items())

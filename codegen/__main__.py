@@ -35,6 +35,7 @@ DERIVATIONS = (
     "chain_ik1a5r",
     "chain_ik_wrist",
     "chain_ik_parallel",
+    "chain_ik_three_parallel",
 )
 # The derivations whose kernels a derivation's kernels call (`Call`): --only runs them too.
 NEEDS = {"chain_dynamics_derivatives": ("chain_dynamics",)}
@@ -62,6 +63,7 @@ COST = {
     ("chain_ik1a5r", 3): 12,
     ("chain_ik_wrist", None): 2,
     ("chain_ik_parallel", None): 2,
+    ("chain_ik_three_parallel", None): 1,
 }
 
 

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 6070616e24c047f7
+Content hash: ee0d9714e852d8e7
 """

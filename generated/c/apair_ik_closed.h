@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_closed.h (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_closed.h. Content hash: 948dbd1d7b570892
+ * generated/c. Do not edit: edit src/csrc/apair_ik_closed.h. Content hash: bd6ac81bbfa9022d
  */
 /*
  * Private to the closed-form solvers of six-joint R-chains (apair_ik_wrist.c, apair_ik_parallel.c;
@@ -18,7 +18,6 @@
 #define CLOSED_DOUBLE 1e-14   /* a squared sine within this (relative) of 0: one root, not two */
 #define CLOSED_TANGENT 1e-8  /* a local extremum of the polynomial this close to 0 (relative) is a root */
 #define CLOSED_INV_MAX 1024
-#define CLOSED_PI 3.14159265358979323846
 #define CLOSED_ROOTS 16 /* room for closed_real_roots' answer: 3 for d = 2, at most 2 n(d - 1) + 1 above: 15 for d = 4 */
 
 GAUSS_SOLVE(closed_solve6, double, fabs)
@@ -119,7 +118,7 @@ static int closed_real_roots(int d, const double *c, double *roots)
  * degree drops: the root at t = infinity) into psi (room for CLOSED_ROOTS + 1): their count, or -1
  * where every coefficient is below CLOSED_FLAT ref, the size of its terms (psi then moves nothing
  * the polynomial sees: not separated). */
-static int closed_half_angles(int deg, const double *c, double ref, double *psi)
+static inline int closed_half_angles(int deg, const double *c, double ref, double *psi)
 {
     double size = 0.0, cn[5], roots[CLOSED_ROOTS];
     for (int k = 0; k <= deg; k++) size = fmax(size, fabs(c[k]));
@@ -131,27 +130,6 @@ static int closed_half_angles(int deg, const double *c, double ref, double *psi)
     for (int k = 0; k < n; k++) psi[k] = 2 * atan(roots[k]);
     if (top < deg) psi[n++] = CLOSED_PI;
     return n;
-}
-
-static void closed_dh4(double a, double ca, double sa, double c, double psi, double *A) /* Rz(psi) Tz(c) Tx(a) Rx(alpha), 3 x 4 */
-{
-    double ct = cos(psi), st = sin(psi);
-    double m[12] = {ct, -st * ca, st * sa, a * ct, st, ct * ca, -ct * sa, a * st, 0.0, sa, ca, c};
-    memcpy(A, m, sizeof m);
-}
-
-static void closed_mul34(const double *A, const double *B, double *C) /* rigid 3 x 4 products */
-{
-    double t[12];
-    for (int r = 0; r < 3; r++)
-        for (int k = 0; k < 4; k++)
-            t[4 * r + k] = A[4 * r] * B[k] + A[4 * r + 1] * B[4 + k] + A[4 * r + 2] * B[8 + k] + (k == 3 ? A[4 * r + 3] : 0.0);
-    memcpy(C, t, sizeof t);
-}
-
-static double closed_wrap(double x) /* into (-pi, pi], as apair.ik.poses.wrap */
-{
-    return x - 2 * CLOSED_PI * ceil((x - CLOSED_PI) / (2 * CLOSED_PI));
 }
 
 /* fk and (if J) the Jacobian (6 x 6) at joint angles q; the pose error e as apair.ik.poses:
@@ -230,21 +208,6 @@ static void closed_keep(double *q, double *error, int *found, const double *x, d
         memcpy(q + 6 * *found, x, 6 * sizeof *x);
         error[(*found)++] = err;
     }
-}
-
-/* the solutions of one pose ascending by joint 1, then 2, ... (apair.ik.poses.refine's order) */
-static void closed_sort(double *qj, double *ej, int found)
-{
-    for (int a = 1; a < found; a++)
-        for (int b = a; b > 0; b--) {
-            double *u = qj + 6 * (b - 1), *v = qj + 6 * b;
-            int k = 0;
-            while (k < 6 && u[k] == v[k]) k++;
-            if (k == 6 || u[k] < v[k]) break;
-            double t[6], te = ej[b - 1];
-            memcpy(t, u, sizeof t); memcpy(u, v, sizeof t); memcpy(v, t, sizeof t);
-            ej[b - 1] = ej[b]; ej[b] = te;
-        }
 }
 
 #endif

@@ -1,6 +1,7 @@
 /*
  * apair._native.ClosedIK: the single-pose fast path of AChain.ik for the chains solved in closed form
- * (apair.ik.wrist, apair.ik.parallel): the design prepared once in C (apair_ik_closed_init), and
+ * (apair.ik.forms: a family's form at the tool end or the base end): the design prepared once in C
+ * (apair_ik_closed_init), and
  * call(T, tol), which solves one canonical pose or returns None for whatever the validating path
  * must see. Part of the binding apair._native (see _native.c; _native.h is what its files share).
  *
@@ -25,7 +26,8 @@ static void closed_dealloc(ClosedIKObject *self)
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
-/* ClosedIK(family, dh, scale, reach): family 1 (a spherical wrist) or 2 (axes 2, 3, 4 parallel) */
+/* ClosedIK(family, dh, scale, reach): family 1 (a spherical wrist) or 2 (axes 2, 3, 4 parallel), or'ed
+ * with 4 where it sits at the base end (apair_ik_closed_init) */
 static int closed_init(ClosedIKObject *self, PyObject *args, PyObject *kwds)
 {
     PyObject *dh_obj;
@@ -121,7 +123,7 @@ PyTypeObject apair_native_closed_ik_type = {
     .tp_dealloc = (destructor)closed_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
     .tp_doc = "ClosedIK(family, dh, scale, reach): the single-pose fast path of AChain.ik for chains solved in "
-              "closed form (1: a spherical wrist, 2: axes 2, 3, 4 parallel; apair.ik.solver).",
+              "closed form (1: a spherical wrist, 2: axes 2, 3, 4 parallel, | 4 at the base end; apair.ik.solver).",
     .tp_methods = closed_methods,
     .tp_init = (initproc)closed_init,
     .tp_new = PyType_GenericNew,

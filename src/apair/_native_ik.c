@@ -1,7 +1,7 @@
 /*
  * apair._native's inverse kinematics: the functions ik_*, the entry points of the hand-written
  * solvers in generated/c (apair_ik_track.c, apair_ik6r.c, apair_ik_local.c, apair_ik4.c,
- * apair_ik_wrist.c, apair_ik_parallel.c), one row
+ * apair_ik_wrist.c, apair_ik_parallel.c, apair_ik_three_parallel.c), one row
  * each of the table ik_entries, all marshalled by ik_marshal. Part of the binding apair._native
  * (see _native.c; _native.h is what its files share).
  *
@@ -149,6 +149,12 @@ static int run_parallel(const ik_call *c)
                              out(c, 3), out(c, 4));
 }
 
+static int run_three_parallel(const ik_call *c)
+{
+    return apair_ik_three_parallel(in(c, 0), c->s[1].d, c->rows, in(c, 2), 16, c->s[3].d, out(c, 0), out(c, 1),
+                                   out(c, 2), out(c, 3), out(c, 4));
+}
+
 static int prepare_pencil(ik_call *c)
 {
     const int d[2] = {len(c, 0, 0) - 1, len(c, 0, 1) - 1}, *af = in(c, 2), *ag = in(c, 4);
@@ -197,7 +203,7 @@ static int run_left(const ik_call *c)
 
 /* ---- the table */
 
-enum { IK_TRACK, IK_TRACK_SLICE, IK6R_ANGLES, IK_NEWTON, IK_LOCAL, IK4_PENCIL, IK4_SCREEN, IK4_LEFT, IK_WRIST, IK_PARALLEL };
+enum { IK_TRACK, IK_TRACK_SLICE, IK6R_ANGLES, IK_NEWTON, IK_LOCAL, IK4_PENCIL, IK4_SCREEN, IK4_LEFT, IK_WRIST, IK_PARALLEL, IK_THREE_PARALLEL };
 
 static const ik_entry ik_entries[] = {
     [IK_TRACK] = {
@@ -282,6 +288,14 @@ static const ik_entry ik_entries[] = {
                 {"candidates", I32, 1, {ROWS}}, {"flags", I32, 1, {ROWS}}},
         .rows = 2, .nogil = 1, .run = run_parallel,
         .error = "ik_parallel: axes 2, 3, 4 not parallel, axes 5 and 6 one line, or a scale <= 0",
+    },
+    [IK_THREE_PARALLEL] = {
+        .format = "OdOd", /* dh, scale, target, tol */
+        .arrays = {{"dh", F64, 2, {6, 4}}, {"target", F64, 3, {ANY, 4, 4}}},
+        .out = {{"q", F64, 3, {ROWS, 8, 6}}, {"error", F64, 2, {ROWS, 8}}, {"found", I32, 1, {ROWS}},
+                {"candidates", I32, 1, {ROWS}}, {"flags", I32, 1, {ROWS}}},
+        .rows = 2, .nogil = 1, .run = run_three_parallel,
+        .error = "ik_three_parallel: axes 1, 2, 3 not parallel, axes 5 and 6 not meeting, or a scale <= 0",
     },
 };
 
@@ -404,6 +418,7 @@ static PyObject *ik4_screen(PyObject *m, PyObject *args) { return ik_marshal(m, 
 static PyObject *ik4_left(PyObject *m, PyObject *args) { return ik_marshal(m, IK4_LEFT, args); }
 static PyObject *ik_wrist(PyObject *m, PyObject *args) { return ik_marshal(m, IK_WRIST, args); }
 static PyObject *ik_parallel(PyObject *m, PyObject *args) { return ik_marshal(m, IK_PARALLEL, args); }
+static PyObject *ik_three_parallel(PyObject *m, PyObject *args) { return ik_marshal(m, IK_THREE_PARALLEL, args); }
 
 /* ---- LocalIK: the single-pose fast path of AChain.ik_local
  *
@@ -666,5 +681,7 @@ PyMethodDef apair_native_ik_methods[] = {
      "ik_wrist(dh, scale, target, tol) -> (q, error, found, candidates, flags): apair_ik_wrist."},
     {"ik_parallel", ik_parallel, METH_VARARGS,
      "ik_parallel(dh, scale, target, tol) -> (q, error, found, candidates, flags): apair_ik_parallel."},
+    {"ik_three_parallel", ik_three_parallel, METH_VARARGS,
+     "ik_three_parallel(dh, scale, target, tol) -> (q, error, found, candidates, flags): apair_ik_three_parallel."},
     {NULL, NULL, 0, NULL},
 };

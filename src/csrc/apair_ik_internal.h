@@ -34,7 +34,46 @@ typedef double _Complex cplx;
 
 #define NMAX 6 /* the most joints of a chain */
 
-/* The closed forms of six R-pairs (apair_ik_wrist.c, apair_ik_parallel.c; their shared steps in
+/* The closed forms' DH steps (static inline: every solver's file may take them) */
+#define CLOSED_PI 3.14159265358979323846
+
+static inline void closed_dh4(double a, double ca, double sa, double c, double psi, double *A) /* Rz(psi) Tz(c) Tx(a) Rx(alpha), 3 x 4 */
+{
+    double ct = cos(psi), st = sin(psi);
+    double m[12] = {ct, -st * ca, st * sa, a * ct, st, ct * ca, -ct * sa, a * st, 0.0, sa, ca, c};
+    memcpy(A, m, sizeof m);
+}
+
+static inline void closed_mul34(const double *A, const double *B, double *C) /* rigid 3 x 4 products */
+{
+    double t[12];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 4; k++)
+            t[4 * r + k] = A[4 * r] * B[k] + A[4 * r + 1] * B[4 + k] + A[4 * r + 2] * B[8 + k] + (k == 3 ? A[4 * r + 3] : 0.0);
+    memcpy(C, t, sizeof t);
+}
+
+static inline double closed_wrap(double x) /* into (-pi, pi], as apair.ik.poses.wrap */
+{
+    return x - 2 * CLOSED_PI * ceil((x - CLOSED_PI) / (2 * CLOSED_PI));
+}
+
+/* the solutions of one pose ascending by joint 1, then 2, ... (apair.ik.poses.refine's order) */
+static inline void closed_sort(double *qj, double *ej, int found)
+{
+    for (int a = 1; a < found; a++)
+        for (int b = a; b > 0; b--) {
+            double *u = qj + 6 * (b - 1), *v = qj + 6 * b;
+            int k = 0;
+            while (k < 6 && u[k] == v[k]) k++;
+            if (k == 6 || u[k] < v[k]) break;
+            double t[6], te = ej[b - 1];
+            memcpy(t, u, sizeof t); memcpy(u, v, sizeof t); memcpy(v, t, sizeof t);
+            ej[b - 1] = ej[b]; ej[b] = te;
+        }
+}
+
+/* The closed forms of six R-pairs (apair_ik_wrist.c, apair_ik_parallel.c, apair_ik_three_parallel.c; their shared steps in
  * apair_ik_closed.h). */
 #define CLOSED_MAX 8 /* the most solutions kept per pose (a 6R chain of these families has at most 8) */
 /* Each closed form's design read once into `design` (apair_ik_closed's storage; 0, or -1 where the
@@ -47,6 +86,9 @@ void apair_ik_wrist_solve1(const void *design, const double *T, double tol, doub
 int apair_ik_parallel_prepare(void *design, const double *dh, double scale);
 void apair_ik_parallel_solve1(const void *design, const double *T, double tol, double *q, double *error, int *found,
                               int *candidates, int *flags);
+int apair_ik_three_parallel_prepare(void *design, const double *dh, double scale);
+void apair_ik_three_parallel_solve1(const void *design, const double *T, double tol, double *q, double *error,
+                                    int *found, int *candidates, int *flags);
 
 /* GAUSS_SOLVE(name, T, mag) defines `static int name(int n, T *A, int m, T *B)` for the scalar
  * type T (mag: its absolute value). It solves A X = B (A n x n, row-major, overwritten; B n x m,

@@ -2,8 +2,9 @@
 apair_ik_closed_solve pose after pose, in storage the program owns; the library allocates nothing,
 test_c_hygiene): a program built from the generated sources it needs, with the strict warnings and,
 where the compiler links them, ASan and UBSan, gives the Python runtime's solutions on a UR5 (axes
-2, 3, 4 parallel) and a PUMA 560 (a spherical wrist), and refuses a chain its family's closed form
-does not take."""
+2, 3, 4 parallel), a PUMA 560 (a spherical wrist) and a design with axes 1, 2, 3 parallel and 5, 6
+meeting, each also mounted wrist-first (APAIR_IK_REVERSED),
+and refuses a chain its family's closed form does not take."""
 
 from __future__ import annotations
 
@@ -32,7 +33,18 @@ ARMS = {  # (family, a, alpha, d)
         [-PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0],
         [0, 0, 0.15005, 0.4318, 0, 0],
     ),
+    "parallel123": (3, [0.3, 0.25, 0.1, 0.05, 0, 0.02], [0, 0, 1.1, -0.7, 0.9, 0.3], [0.2, 0.05, 0.1, 0.15, 0.08, 0.1]),
 }
+
+
+def _upside_down(family: int, a, alpha, d) -> tuple:
+    """The arm mounted wrist-first (its reversed chain is the arm, a_6 = 0.05, α_6 = 0.4): the
+    family | APAIR_IK_REVERSED (4)."""
+    a, alpha, d = (np.asarray(x, float) for x in (a, alpha, d))
+    return family | 4, np.append(-a[4::-1], 0.05).tolist(), np.append(-alpha[4::-1], 0.4).tolist(), (-d[::-1]).tolist()
+
+
+ARMS.update({f"{name}_wrist_first": _upside_down(*ARMS[name]) for name in list(ARMS)})
 # the registry's entries for the two kernels the solvers look up (apair_find_kernel): the program
 # links these kernels alone, not the whole registry
 REGISTRY = """
@@ -56,10 +68,12 @@ SOURCES = [
     "apair_ik_closed.c",
     "apair_ik_wrist.c",
     "apair_ik_parallel.c",
+    "apair_ik_three_parallel.c",
     "fk6.c",
     "jacobian6.c",
     "ik_wrist_position6.c",
     "ik_parallel_position6.c",
+    "ik_three_parallel6.c",
 ]
 
 
@@ -94,6 +108,7 @@ def program(poses: dict[str, np.ndarray]) -> str:
         "    /* a PUMA is not a UR: its family's form refuses it */",
         "    if (apair_ik_closed_init(&solver, 2, dh_PUMA560, 0.4) != -1) return 3;",
         "    if (apair_ik_closed_solve(&solver, 1, T_PUMA560, 16, 1e-9, q, err, found, cands, flags) != -1) return 4;",
+        "    if (apair_ik_closed_init(&solver, 8, dh_PUMA560, 0.4) != -1) return 5; /* no such family */",
         "    return 0;",
         "}",
     ]

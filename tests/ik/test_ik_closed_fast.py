@@ -1,6 +1,6 @@
 """The single-pose fast path of `ik` for the chains solved in closed form (apair._native.ClosedIK,
-set up with the chain's solver): the same numbers as the validating path on spherical-wrist and
-UR arms, reachable and unreachable poses; whatever it declines (other dtypes, NaN, a pose that is
+set up with the chain's solver): the same numbers as the validating path on spherical-wrist, UR
+and 1∥2∥3 arms, reachable and unreachable poses; whatever it declines (other dtypes, NaN, a pose that is
 not rigid, a bad tol, full=True, frames) goes to the validating path, which answers or raises as
 before; the NumPy backend keeps its twin; a chain pickles after ik."""
 
@@ -11,6 +11,7 @@ import pickle
 import numpy as np
 import pytest
 import test_ik_parallel as parallel_arms
+import test_ik_three_parallel as three_parallel_arms
 import test_ik_wrist as wrist_arms
 
 import apair
@@ -21,7 +22,7 @@ pytestmark = pytest.mark.skipif(not apair.c_available(), reason="the compiled C 
 
 
 def arms():
-    for mod in (wrist_arms, parallel_arms):
+    for mod in (wrist_arms, parallel_arms, three_parallel_arms):
         for name in mod.ARMS:
             yield name, mod.arm(name)
 

@@ -28,7 +28,7 @@ def real_roots(coeffs: NDArray[np.float64], ref: float) -> tuple[list[float], bo
     if top == 0:
         return [], at_infinity
     poly = c[: top + 1][::-1]
-    roots = [float(t.real) for t in np.roots(poly) if abs(t.imag) <= ROOT_IMAG * (1 + abs(t))]
+    roots = [_polish(poly, float(t.real)) for t in np.roots(poly) if abs(t.imag) <= ROOT_IMAG * (1 + abs(t))]
     # a critical point where the polynomial (nearly) vanishes: a double root, exact where the two
     # roots come sqrt(eps) off it (as the C twin, apair_ik_closed.h)
     for x in np.roots(np.polyder(poly)) if top > 1 else []:
@@ -37,6 +37,24 @@ def real_roots(coeffs: NDArray[np.float64], ref: float) -> tuple[list[float], bo
             if abs(np.polyval(poly, x)) <= TANGENT * max(1.0, float(np.polyval(np.abs(poly), abs(x)))):
                 roots.append(x)
     return roots, at_infinity
+
+
+def _polish(poly: NDArray[np.float64], x: float) -> float:
+    """Newton steps on a simple root while they shrink |p| (as the C twin's bracketed Newton): the
+    companion matrix's eigenvalues come some 1e-14 off, which a stretched elbow's cos ψ_3 = ±1
+    turns into a spurious pair of elbows 1e-6 apart."""
+    dpoly = np.polyder(poly)
+    px = abs(float(np.polyval(poly, x)))
+    for _ in range(3):
+        d = float(np.polyval(dpoly, x))
+        if d == 0.0 or px == 0.0:
+            break
+        y = x - float(np.polyval(poly, x)) / d
+        py = abs(float(np.polyval(poly, y)))
+        if not py < px:
+            break
+        x, px = y, py
+    return x
 
 
 def note(free: set[str]) -> str:

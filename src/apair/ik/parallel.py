@@ -37,7 +37,7 @@ from .poses import refine
 # the continua apair_ik_parallel flags, by bit
 FLAGS = {
     1: "joints 2, 3, 4 and 6: axis 6 parallel to axes 2, 3 and 4",
-    2: "joint 2: frame 3's origin on axis 2",
+    2: "joints 2 and 4: axes 2 and 4 on one line",
 }
 
 
@@ -55,6 +55,9 @@ def applies(chain, family: Classification) -> bool:
 
 class Parallel:
     """The closed form of one chain: its design read once."""
+
+    code = 2  # the family in apair.h (APAIR_IK_PARALLEL)
+    flags = FLAGS  # the continua its C form flags, by bit
 
     def __init__(self, chain, scale: float) -> None:
         self.chain = chain

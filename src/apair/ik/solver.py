@@ -26,9 +26,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..kernels import native_module
-from . import elimination1a5r, elimination6r, homotopy, parallel, wrist
+from . import elimination1a5r, elimination6r, homotopy
 from .elimination4 import CAND_TOL, Elimination
-from .families import Classification, classify
+from .families import classify
+from .forms import Form, closed_form
 from .local import local_search, on_continuum
 from .pencil import SEED, Degenerate
 from .poses import (
@@ -140,7 +141,7 @@ class Solver:
         self.chain = chain
         self.family = classify(chain)
         self.scale = length_scale(chain)
-        self._closed = _closed_form(chain, self.family, self.scale)
+        self._closed = closed_form(chain, self.family, self.scale)
         self.slides = np.array([p.kind == "prismatic" for p in chain.pairs])
         # the reach bound counts a P-pair's slide within its limits; its solutions are any real d
         self.reach = math.inf if self.slides.any() else reach_of(chain)
@@ -242,10 +243,11 @@ class Solver:
             note = f"the elimination degenerated at this pose{why}, and a local search found no solution"
         return Solution(q, err, 0, None, certified=False, method="local search", note=note)
 
-    def _solve_closed(self, closed: wrist.Wrist | parallel.Parallel, pose: Pose, tol: float) -> Solution:
-        """A spherical wrist (apair.ik.wrist) or three parallel inner axes (apair.ik.parallel):
-        every real solution in closed form, verified. Where the polynomial vanishes identically (a
-        pose or design the closed form does not separate) the homotopy answers."""
+    def _solve_closed(self, closed: Form, pose: Pose, tol: float) -> Solution:
+        """The family's closed form (apair.ik.forms: a spherical wrist, three parallel inner axes, or
+        axes 1-3 parallel with 5 and 6 meeting, at the tool end or the base end): every real solution,
+        verified. Where the polynomial vanishes identically (a pose or design the closed form does
+        not separate) the homotopy answers."""
         try:
             q, err, candidates, note = closed.solve(pose.matrix, tol)
         except ValueError:
@@ -325,25 +327,13 @@ class Solver:
         return np.where(self.slides, real * self.scale, real)
 
 
-def _closed_form(chain: ChainLike, family: Classification, scale: float) -> wrist.Wrist | parallel.Parallel | None:
-    """The closed-form solver of the chain's family, if it has one (apair.ik.wrist, apair.ik.parallel)."""
-    if wrist.applies(chain, family):
-        return wrist.Wrist(chain, scale)
-    if parallel.applies(chain, family):
-        try:
-            return parallel.Parallel(chain, scale)
-        except ValueError:  # a design the closed form does not cover (axes 5 and 6 one line)
-            return None
-    return None
-
-
-def _fast_path(closed: wrist.Wrist | parallel.Parallel | None, scale: float, reach: float) -> Any:
+def _fast_path(closed: Form | None, scale: float, reach: float) -> Any:
     """apair._native.ClosedIK for the closed form, where the C extension is installed, else None."""
     native, _ = native_module()
     if closed is None or native is None:
         return None
     try:
-        return native.ClosedIK(1 if isinstance(closed, wrist.Wrist) else 2, closed.dh, scale, reach)
+        return native.ClosedIK(closed.code, closed.dh, scale, reach)
     except ValueError:  # a design its C form does not prepare: the validating path answers
         return None
 

@@ -63,6 +63,9 @@ def _rotation(alpha: float, psi: float) -> NDArray[np.float64]:
 class Wrist:
     """The closed form of one chain: its design read once."""
 
+    code = 1  # the family in apair.h (APAIR_IK_WRIST)
+    flags = FLAGS  # the continua its C form flags, by bit
+
     def __init__(self, chain, scale: float) -> None:
         self.chain = chain
         self.dh = np.column_stack([chain.a, chain.alpha, chain.offset, chain.theta_offset]).astype(np.float64)

@@ -1,0 +1,37 @@
+"""Which closed form solves a six-joint R-chain (issue 42): its family's (apair.ik.wrist,
+apair.ik.parallel, apair.ik.three_parallel), at the tool end or, for a family at the base end, the
+reversed chain's (apair.ik.reverse); None where the chain has none (the general solvers answer)."""
+
+from __future__ import annotations
+
+from . import parallel, three_parallel, wrist
+from .families import Classification, classify
+from .reverse import Reversed, ReversedView
+
+Forward = wrist.Wrist | parallel.Parallel | three_parallel.ThreeParallel
+Form = Forward | Reversed
+
+
+def forward_form(chain, family: Classification, scale: float) -> Forward | None:
+    """The closed-form solver of a chain's forward family (`family`: classify(chain))."""
+    if wrist.applies(chain, family):
+        return wrist.Wrist(chain, scale)
+    for module, make in ((parallel, parallel.Parallel), (three_parallel, three_parallel.ThreeParallel)):
+        if module.applies(chain, family):
+            try:
+                return make(chain, scale)
+            except ValueError:  # a design the closed form does not cover (e.g. axes 5 and 6 one line)
+                return None
+    return None
+
+
+def closed_form(chain, family: Classification, scale: float) -> Form | None:
+    """The closed-form solver of the chain's family (`family`: classify(chain)), forward or at the
+    base end, if it has one."""
+    form = forward_form(chain, family, scale)
+    f = family.family
+    if form is not None or f is None or not f.reversed or any(p.kind != "revolute" for p in chain.pairs):
+        return form
+    view = ReversedView(chain)
+    inner = forward_form(view, classify(view), scale)
+    return None if inner is None else Reversed(chain, scale, view, inner)
