@@ -32,7 +32,7 @@ def random_inputs(spec, rng: np.random.Generator, count: int) -> list[np.ndarray
         law = out[names.index("law")]
         half = rng.uniform(-np.pi, np.pi, law.shape[:-1])
         law[..., 0], law[..., 1] = np.cos(half), np.sin(half)
-    if spec.name.startswith("ik_") and not spec.name.startswith(("ik_wrist", "ik_parallel")):
+    if spec.name.startswith("ik_") and not spec.name.startswith(("ik_wrist", "ik_parallel", "ik_three_parallel")):
         # the homotopy's kernels at a complex angle θ, |Im θ| <= 1 (the closed forms take a real pose)
         dims = (count,) + spec.inputs[0].shape[: -2 if spec.name.startswith("ik_system") else -1]
         theta = rng.uniform(-np.pi, np.pi, dims) + 1j * rng.uniform(-1, 1, dims)
