@@ -1,7 +1,8 @@
 """The closed-form inverse kinematics of arms with a spherical wrist, of UR arms (three parallel
 inner axes) and of a design with axes 1, 2, 3 parallel and 5, 6 meeting (issue 42), two of them
 also mounted wrist-first (the family at the base end), against
-EAIK and IK-Geo, side by side on the same poses in one run
+EAIK and IK-Geo (and of UR arms with an A-pair at joint 3, which no peer solves, against apair's
+general solver), side by side on the same poses in one run
 (`bench/run.py --ik-closed-only`, and in the full run): single Python calls (apair's `chain.ik(T)`,
 EAIK's `IK(T)`, IK-Geo's `get_ik(R, t)`, interleaved pose by pose), apair's batched C call
 (`apair._native.ik_wrist` or `ik_parallel` on N poses) against
@@ -17,7 +18,9 @@ import numpy as np
 
 import apair
 from apair.ik.parallel import Parallel
+from apair.ik.parallel_apair import ParallelAPair
 from apair.ik.poses import length_scale
+from apair.ik.solver import Solver
 from apair.ik.three_parallel import ThreeParallel
 from apair.ik.wrist import Wrist
 from apair.kernels import native_module
@@ -74,8 +77,10 @@ IKGEO = {"three-inner-parallel": "three_parallel_two_intersecting"}
 SAME = 1e-6
 
 
-def _among(q, sols) -> bool:
-    d = np.abs((np.asarray(sols).reshape(-1, 6) - q + PI) % (2 * PI) - PI)
+def _among(q, sols, period: float = 2 * PI) -> bool:
+    """q among sols, each joint within SAME modulo `period` (4π for an A-pair's angle: every joint
+    is compared modulo it, which for R-pairs' (−π, π] angles is the same)."""
+    d = np.abs((np.asarray(sols).reshape(-1, 6) - q + period / 2) % period - period / 2)
     return bool(np.any(np.all(d < SAME, axis=1)))
 
 
@@ -173,6 +178,66 @@ def section(quick: bool) -> dict:
             + f"; EAIK solutions missing from apair's: {missing}",
             flush=True,
         )
+    out["a_pair_arms"] = a_pair_section(quick)
+    return out
+
+
+A_ARMS = {  # UR arms with a sinusoidal A-pair at joint 3 (r_b = 0.06, r_p = 0.05: h = 0.0775 m)
+    "UR5 + A-pair at joint 3": ARMS["UR5"],
+    "UR10e + A-pair at joint 3": ARMS["UR10e"],
+}
+
+
+def a_pair_section(quick: bool) -> dict:
+    """UR arms with an A-pair at joint 3 (apair.ik.parallel_apair: no peer solves them): apair's
+    closed form against its general solver (the homotopy), single Python calls on the same poses, one
+    route after the other, and whether their solution sets agree where the general solver certifies
+    its set; and the batched C call."""
+    count, batch = (30, 2000) if quick else (200, 20000)
+    out = {}
+    for name, (a, alpha, d) in A_ARMS.items():
+        R = apair.APair.revolute()
+        chain = apair.AChain([R, R, apair.APair(0.06, 0.05), R, R, R], a=a, alpha=alpha, offset=d)
+        general = Solver(chain)
+        general._closed = None  # the route before the closed form
+        rng = np.random.default_rng(42)
+        q = rng.uniform(-PI, PI, (count, 6))
+        q[:, 2] = rng.uniform(*chain.limits[2], count)
+        Ts = chain.fk(q)
+        chain.ik(Ts[0])
+        general.solve(Ts[0])
+        times: dict[str, list[float]] = {"closed_form": [], "general": []}
+        ours = []
+        for T in Ts:  # each route over all poses in turn: the homotopy's threads and its 10 ms per pose would
+            t0 = time.perf_counter()  # otherwise leave the closed form's single calls a cold cache
+            ours.append(chain.ik(T))
+            times["closed_form"].append(time.perf_counter() - t0)
+        differ = 0
+        for T, mine in zip(Ts, ours):
+            t0 = time.perf_counter()
+            theirs = general.solve(T)
+            times["general"].append(time.perf_counter() - t0)
+            if theirs.certified and (len(mine) != len(theirs.q) or not all(_among(s, theirs.q, 4 * PI) for s in mine)):
+                differ += 1
+        row = {"median_us": {k: float(np.median(v) * 1e6) for k, v in times.items()}, "sets_differ": differ}
+        native, _ = native_module()
+        if native is not None:  # the batched C call (apair_ik_parallel_apair) on `batch` poses, best of 3
+            form = ParallelAPair(chain, length_scale(chain))
+            qb = rng.uniform(-PI, PI, (batch, 6))
+            qb[:, 2] = rng.uniform(*chain.limits[2], batch)
+            Tb = chain.fk(qb)
+            best = min(
+                _timed(lambda: native.ik_parallel_apair(form.dh, form.h, form.scale, Tb, 1e-9)) for _ in range(3)
+            )
+            row["batched_us_per_pose"] = best / batch * 1e6
+        out[name] = row
+        med = row["median_us"]
+        print(
+            f"  {name:27s} single call: closed form {med['closed_form']:8.1f} µs, general solver "
+            f"{med['general']:8.1f} µs; sets differ at {differ} of {count} poses"
+            + (f"; batched {row['batched_us_per_pose']:.1f} µs/pose" if "batched_us_per_pose" in row else ""),
+            flush=True,
+        )
     return out
 
 
@@ -200,6 +265,16 @@ def targets(r: dict) -> list[dict]:
                 "target": f"{name}: every EAIK solution among apair's",
                 "measured": row["eaik_solutions_missing_from_apair"],
                 "met": row["eaik_solutions_missing_from_apair"] == 0,
+            }
+        )
+    for name, row in r.get("a_pair_arms", {}).items():
+        us = row["median_us"]["closed_form"]
+        out.append({"target": f"{name}: <= 50 µs per pose", "measured": us, "met": us <= 50.0})
+        out.append(
+            {
+                "target": f"{name}: the general solver's sets",
+                "measured": row["sets_differ"],
+                "met": row["sets_differ"] == 0,
             }
         )
     return out

@@ -36,6 +36,7 @@ DERIVATIONS = (
     "chain_ik_wrist",
     "chain_ik_parallel",
     "chain_ik_three_parallel",
+    "chain_ik_parallel_apair",
 )
 # The derivations whose kernels a derivation's kernels call (`Call`): --only runs them too.
 NEEDS = {"chain_dynamics_derivatives": ("chain_dynamics",)}
@@ -64,6 +65,7 @@ COST = {
     ("chain_ik_wrist", None): 2,
     ("chain_ik_parallel", None): 2,
     ("chain_ik_three_parallel", None): 1,
+    ("chain_ik_parallel_apair", None): 2,
 }
 
 

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: ee0d9714e852d8e7
+Content hash: 963347a4ac0efa69
 """

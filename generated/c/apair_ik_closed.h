@@ -1,10 +1,10 @@
 /*
  * A copy of src/csrc/apair_ik_closed.h (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_closed.h. Content hash: bd6ac81bbfa9022d
+ * generated/c. Do not edit: edit src/csrc/apair_ik_closed.h. Content hash: 171f743fcf154862
  */
 /*
- * Private to the closed-form solvers of six-joint R-chains (apair_ik_wrist.c, apair_ik_parallel.c;
- * their Python twins share apair.ik.closed): the real roots of their univariate polynomials, the DH
+ * Private to the closed-form solvers of six-joint chains (apair_ik_wrist.c, apair_ik_parallel.c with
+ * its UR arm with an A-pair at joint 3, apair_ik_three_parallel.c; their Python twins share apair.ik.closed): the real roots of their univariate polynomials, the DH
  * joint transform, fk with the pose error, the Gauss-Newton polish, and the merged, sorted set of
  * verified solutions. Static functions: each solver's file gets its own copy to inline.
  */
@@ -18,16 +18,20 @@
 #define CLOSED_DOUBLE 1e-14   /* a squared sine within this (relative) of 0: one root, not two */
 #define CLOSED_TANGENT 1e-8  /* a local extremum of the polynomial this close to 0 (relative) is a root */
 #define CLOSED_INV_MAX 1024
-#define CLOSED_ROOTS 16 /* room for closed_real_roots' answer: 3 for d = 2, at most 2 n(d - 1) + 1 above: 15 for d = 4 */
+#define CLOSED_DEGREE 12 /* the highest degree closed_real_roots takes (the A-pair UR arm's polynomial) */
+#define CLOSED_ROOTS 64 /* room for closed_real_roots' answer: 3 for d = 2, at most 2 n(d - 1) + 1 above (15 for
+                         * d = 4); above that the candidates (a root per sign change, a near-zero critical point
+                         * each) stay far below it unless roots cluster, and any beyond it are dropped */
 
 GAUSS_SOLVE(closed_solve6, double, fabs)
 
 
-/* fk6 and jacobian6 with their invariants for one design (all joints R-pairs) */
+/* fk6 and jacobian6 with their invariants for one design: R-pairs, and sinusoidal A-pairs of
+ * amplitude amp[i] (0 for an R-pair) */
 typedef struct {
     const apair_kernel *fk, *jac;
     double inv_fk[CLOSED_INV_MAX], inv_jac[CLOSED_INV_MAX];
-    double turning[6];
+    double turning[6], amp[6];
 } closed_fk;
 
 /* 0, or -1 where the kernels are missing or too big for the buffers */
@@ -36,7 +40,7 @@ static int closed_fk_init(closed_fk *k, const double *dh)
     k->fk = apair_find_kernel("fk6");
     k->jac = apair_find_kernel("jacobian6");
     if (!k->fk || !k->jac || k->fk->n_invariants > CLOSED_INV_MAX || k->jac->n_invariants > CLOSED_INV_MAX) return -1;
-    for (int i = 0; i < 6; i++) k->turning[i] = 1.0;
+    for (int i = 0; i < 6; i++) { k->turning[i] = 1.0; k->amp[i] = 0.0; }
     const double *in[3] = {NULL, dh, k->turning};
     if (k->fk->n_invariants) k->fk->invariants(in, k->inv_fk);
     if (k->jac->n_invariants) k->jac->invariants(in, k->inv_jac);
@@ -57,10 +61,10 @@ static double closed_magnitude(int d, const double *c, double x)
     return s;
 }
 
-/* The real roots of sum c_k x^k (degree d <= 4, c[d] != 0, coefficients of size about 1): a root
- * in each interval between the real roots of the derivative where the sign changes, and each
- * critical point within CLOSED_TANGENT of zero (a double root, or two roots too close to
- * separate): candidates, some repeated, at most 3 for d = 2 and 15 for d = 4. */
+/* The real roots of sum c_k x^k (degree d <= CLOSED_DEGREE, c[d] != 0, coefficients of size about
+ * 1): a root in each interval between the real roots of the derivative where the sign changes, and
+ * each critical point within CLOSED_TANGENT of zero (a double root, or two roots too close to
+ * separate): candidates, some repeated, at most 3 for d = 2 and 15 for d = 4, CLOSED_ROOTS in all. */
 static int closed_real_roots(int d, const double *c, double *roots)
 {
     if (d <= 0) return 0;
@@ -78,12 +82,17 @@ static int closed_real_roots(int d, const double *c, double *roots)
         if (near) roots[n++] = -c[1] / (2 * c[2]);
         return n;
     }
-    double dc[4], crit[CLOSED_ROOTS];
+    double dc[CLOSED_DEGREE], crit[CLOSED_ROOTS];
     for (int k = 1; k <= d; k++) dc[k - 1] = k * c[k];
     int nc = closed_real_roots(d - 1, dc, crit);
-    double bound = 0.0;
-    for (int k = 0; k < d; k++) bound = fmax(bound, fabs(c[k] / c[d]));
-    bound += 1.0;
+    /* every root within the smaller of Cauchy's and Fujiwara's bounds (Fujiwara's is far tighter where
+     * the leading coefficient is small: Newton's method from a far end gains only a factor 1 - 1/d a step) */
+    double cauchy = 0.0, fujiwara = 0.0;
+    for (int k = 0; k < d; k++) {
+        cauchy = fmax(cauchy, fabs(c[k] / c[d]));
+        fujiwara = fmax(fujiwara, pow(fabs(c[k] / c[d]) * (k == 0 ? 0.5 : 1.0), 1.0 / (d - k)));
+    }
+    double bound = fmin(cauchy + 1.0, 2.0 * fujiwara);
     double ends[CLOSED_ROOTS + 2];
     int ne = 0;
     ends[ne++] = -bound;
@@ -92,20 +101,32 @@ static int closed_real_roots(int d, const double *c, double *roots)
     int n = 0;
     for (int k = 0; k + 1 < ne; k++) {
         double lo = ends[k], hi = ends[k + 1], flo = closed_horner(d, c, lo), fhi = closed_horner(d, c, hi);
+        if (n >= CLOSED_ROOTS - 1) break;
         if (k > 0 && fabs(flo) <= CLOSED_TANGENT * fmax(1.0, closed_magnitude(d, c, lo))) roots[n++] = lo; /* at a critical point */
         if (flo == 0.0) continue;
         if ((flo < 0) == (fhi < 0)) continue;
-        /* Newton's method from the secant point, kept inside the bracket (a bisection step where it
-         * would leave it), to 1e-14 relative: the candidates are polished on fk afterwards */
+        /* Laguerre's method from the secant point (one step lands near a root from afar, where Newton's
+         * gains only a factor 1 - 1/d), else Newton's, kept inside the bracket (a bisection step, on a log
+         * scale across magnitudes, where both would leave it), to 1e-14 relative: the candidates are
+         * polished on fk afterwards */
         double x = lo - flo * (hi - lo) / (fhi - flo);
         if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
         for (int it = 0; it < 100; it++) {
-            double f = c[d], df = 0.0;
-            for (int k = d - 1; k >= 0; k--) { df = df * x + f; f = f * x + c[k]; }
+            double f = c[d], df = 0.0, ddf = 0.0;
+            for (int k = d - 1; k >= 0; k--) {
+                ddf = ddf * x + df;
+                df = df * x + f;
+                f = f * x + c[k];
+            }
             if (f == 0.0) break;
             if ((f < 0) == (flo < 0)) lo = x; else hi = x;
-            double next = x - f / df;
-            if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+            double G = df / f, H = G * G - 2 * ddf / f, disc = (d - 1) * (d * H - G * G), next = x - f / df;
+            if (disc >= 0) {
+                double den = G + copysign(sqrt(disc), G), leap = den != 0.0 ? x - d / den : next;
+                if (leap > lo && leap < hi) next = leap;
+            }
+            if (!(next > lo && next < hi))
+                next = lo > 0 && hi > 4 * lo ? sqrt(lo * hi) : hi < 0 && lo < 4 * hi ? -sqrt(lo * hi) : 0.5 * (lo + hi);
             if (fabs(next - x) <= 1e-14 * fmax(1.0, fabs(x)) || hi - lo <= 1e-14 * fmax(1.0, fabs(lo))) { x = next; break; }
             x = next;
         }
@@ -114,13 +135,13 @@ static int closed_real_roots(int d, const double *c, double *roots)
     return n;
 }
 
-/* The angles psi = 2 atan t of the real roots t of sum c_k t^k (degree deg <= 4; psi = pi where the
+/* The angles psi = 2 atan t of the real roots t of sum c_k t^k (degree deg <= CLOSED_DEGREE; psi = pi where the
  * degree drops: the root at t = infinity) into psi (room for CLOSED_ROOTS + 1): their count, or -1
  * where every coefficient is below CLOSED_FLAT ref, the size of its terms (psi then moves nothing
  * the polynomial sees: not separated). */
 static inline int closed_half_angles(int deg, const double *c, double ref, double *psi)
 {
-    double size = 0.0, cn[5], roots[CLOSED_ROOTS];
+    double size = 0.0, cn[CLOSED_DEGREE + 1], roots[CLOSED_ROOTS];
     for (int k = 0; k <= deg; k++) size = fmax(size, fabs(c[k]));
     if (!(size > CLOSED_FLAT * ref)) return -1;
     for (int k = 0; k <= deg; k++) cn[k] = c[k] / size;
@@ -138,10 +159,13 @@ static double closed_evaluate(const closed_fk *w, const double *dh, double scale
                        double *e, double *J)
 {
     double law[30], T[16];
-    for (int i = 0; i < 6; i++) {
-        law[5 * i] = cos(0.5 * q[i]);
-        law[5 * i + 1] = sin(0.5 * q[i]);
-        law[5 * i + 2] = law[5 * i + 3] = law[5 * i + 4] = 0.0;
+    for (int i = 0; i < 6; i++) { /* a sinusoidal pair's d = h C, d' = -h S / 2, d'' = -h C / 4 (C, S: of q / 2) */
+        double C = cos(0.5 * q[i]), S = sin(0.5 * q[i]), h = w->amp[i];
+        law[5 * i] = C;
+        law[5 * i + 1] = S;
+        law[5 * i + 2] = h != 0.0 ? h * C : 0.0;
+        law[5 * i + 3] = h != 0.0 ? -0.5 * h * S : 0.0;
+        law[5 * i + 4] = h != 0.0 ? -0.25 * h * C : 0.0;
     }
     const double *in[3] = {law, dh, w->turning};
     double *outT[1] = {T};

@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_parallel.c (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_parallel.c. Content hash: 8f832873b4ffd8ad
+ * generated/c. Do not edit: edit src/csrc/apair_ik_parallel.c. Content hash: f60f11a7c8842213
  */
 /*
  * The closed-form inverse kinematics of six-joint R-chains with axes 2, 3 and 4 parallel (UR arms;
@@ -9,7 +9,8 @@
  * the polynomial in t = tan(psi_1/2) whose real roots give psi_1; psi_5, psi_6, the elbow's psi_3,
  * psi_2 and psi_4 follow in closed form, and each candidate gets up to two Gauss-Newton steps on
  * fk6 and jacobian6 and is kept where fk reproduces the pose to tol (apair_ik_closed.h, shared with
- * apair_ik_wrist.c). Hand-written C: the C backend of codegen copies it into generated/c, the
+ * apair_ik_wrist.c). The same steps serve a UR arm with a sinusoidal A-pair at joint 3 (below, after
+ * the R-arm's). Hand-written C: the C backend of codegen copies it into generated/c, the
  * library it belongs to. Declared in apair.h (template: codegen/backends/c/templates/apair.h.j2).
  */
 #include "apair_ik_closed.h"
@@ -78,33 +79,44 @@ static void frame3(const parallel_design *p, const double *dh, const double *Tt,
     for (int r = 0; r < 2; r++) O3[r] = N[4 * r + 3] - (N[4 * r] * p->o3[0] + N[4 * r + 1] * p->o3[1] + N[4 * r + 2] * p->o3[2]);
 }
 
-/* Where axis 6 is parallel to axes 2-4, psi_6 is free: frame 3's origin then runs on a circle as
- * psi_6 turns, rho^2 = A + B cos psi_6 + C sin psi_6; the member taken has the elbow at cos psi_3 = 0
- * (rho^2 = a_2^2 + a_3^2, the middle of its range) where the circle reaches it, else the nearest. */
-static double free_psi6(const parallel_design *p, const double *dh, const double *Tt, double psi1, double psi5)
+/* rho^2 = A + B cos psi_6 + C sin psi_6: frame 3's distance from axis 2 as psi_6 turns */
+static void circle(const parallel_design *p, const double *dh, const double *Tt, double psi1, double psi5, double *A,
+                   double *B, double *C)
 {
     double N[12], O3[2], r[3];
     for (int k = 0; k < 3; k++) {
         frame3(p, dh, Tt, psi1, psi5, k * CLOSED_PI / 2, N, O3);
         r[k] = O3[0] * O3[0] + O3[1] * O3[1];
     }
-    double A = 0.5 * (r[0] + r[2]), B = 0.5 * (r[0] - r[2]), C = r[1] - A, K = hypot(B, C);
+    *A = 0.5 * (r[0] + r[2]);
+    *B = 0.5 * (r[0] - r[2]);
+    *C = r[1] - *A;
+}
+
+/* Where axis 6 is parallel to axes 2-4, psi_6 is free: frame 3's origin then runs on a circle as
+ * psi_6 turns, rho^2 = A + B cos psi_6 + C sin psi_6; the member taken has the elbow at cos psi_3 = 0
+ * (rho^2 = a_2^2 + a_3^2, the middle of its range) where the circle reaches it, else the nearest. */
+static double free_psi6(const parallel_design *p, const double *dh, const double *Tt, double psi1, double psi5)
+{
+    double A, B, C;
+    circle(p, dh, Tt, psi1, psi5, &A, &B, &C);
+    double K = hypot(B, C);
     double a2 = dh[4], a3 = dh[8], scale2 = a2 * a2 + a3 * a3;
     if (!(K > CLOSED_FLAT * scale2)) return 0.0;
     return atan2(C, B) + acos(fmin(1.0, fmax(-1.0, (scale2 - A) / K)));
 }
 
-/* psi_2, psi_3, psi_4 of the planar problem left by psi_1, psi_5, psi_6 (per elbow, at most 2):
- * candidates x = psi - phi */
+/* psi_2, psi_3, psi_4 of the planar problem left by psi_1, psi_5, psi_6 (per elbow, at most 2; one,
+ * the stretched or folded elbow, where sin^2 psi_3 <= stretched): candidates x = psi - phi */
 static int inner(const parallel_design *p, const double *dh, double scale, const double *Tt, double psi1, double psi5,
-                 double psi6, double *x, int *flags)
+                 double psi6, double *x, int *flags, double stretched)
 {
     double N[12], O3[2];
     frame3(p, dh, Tt, psi1, psi5, psi6, N, O3); /* N = A_2 A_3 A_4 */
     double a2 = dh[4], a3 = dh[8], rho2 = O3[0] * O3[0] + O3[1] * O3[1];
     double c3 = (rho2 - a2 * a2 - a3 * a3) / (2 * a2 * a3);
     if (!(fabs(c3) <= 1 + 1e-6)) return 0;
-    double rest = 1 - c3 * c3, s3 = rest <= 4 * CLOSED_DOUBLE ? 0.0 : sqrt(rest);
+    double rest = 1 - c3 * c3, s3 = rest <= stretched ? 0.0 : sqrt(rest);
     int n = 0;
     for (int s = 0; s < (s3 > 0 ? 2 : 1); s++) {
         double psi3 = atan2(s ? -s3 : s3, c3), psi2;
@@ -179,7 +191,7 @@ void apair_ik_parallel_solve1(const void *design, const double *Tt, double tol, 
             int singular = hypot(wx, wy) <= CLOSED_SINGULAR; /* axis 6 parallel to axes 2-4: psi_6 free */
             double psi6 = singular ? free_psi6(p, dh, Tt, psi1s[k1], psi5s[k5])
                                    : atan2(wy * vx - wx * vy, wx * vx + wy * vy), x[12];
-            int nx = inner(p, dh, scale, Tt, psi1s[k1], psi5s[k5], psi6, x, flags);
+            int nx = inner(p, dh, scale, Tt, psi1s[k1], psi5s[k5], psi6, x, flags, 4 * CLOSED_DOUBLE);
             for (int k = 0; k < nx; k++) {
                 (*candidates)++;
                 double err = closed_polish(&p->k, dh, scale, Tt, tol, x + 6 * k);
@@ -198,5 +210,228 @@ int apair_ik_parallel(const double *dh, double scale, size_t count, const double
 {
     apair_ik_closed solver;
     if (apair_ik_closed_init(&solver, APAIR_IK_PARALLEL, dh, scale)) return -1;
+    return apair_ik_closed_solve(&solver, count, target, target_stride, tol, q, error, found, candidates, flags);
+}
+
+/* ---- A UR arm with a sinusoidal A-pair at joint 3 (apair.ik.parallel_apair, where the steps are
+ * explained): the derived kernel ik_parallel_apair_position6 (derivations/chain_ik_parallel_apair.py)
+ * gives L_1, L_2, G and H in t = tan(psi_1/2) and the polynomial of degree 12 whose real roots give
+ * psi_1 (a quartic, G = 0, where c_5 = 0); psi_5 = atan2(H/G, L_1/P), then psi_6, the elbows, psi_2
+ * and psi_4 as on the R-arm above; theta_3 is the angle in (-2 pi, 2 pi] whose slide h cos(theta_3/2)
+ * has the sign of cos alpha_2 L_2, with its twin where it is near +-pi. */
+
+#define APAIR_MULTIPLE 1e-4 /* [rad] verified solutions this close are one (a multiple root's cluster) */
+
+typedef struct {
+    parallel_design p; /* the R-arm's steps; its inv_pos holds ik_parallel_apair_position6's invariants */
+    double law[2], h, cphi3;
+    int quartic; /* c_5 = 0: H = 0, and G = 0 is a quartic */
+} apair_design;
+
+/* the prepared design lives in apair_ik_closed's storage */
+typedef char apair_design_fits[sizeof(apair_design) <= sizeof(((apair_ik_closed *)0)->design) ? 1 : -1];
+
+static double wrap4(double x) /* into (-2 pi, 2 pi], an A-pair's angle */
+{
+    return x - 4 * CLOSED_PI * ceil((x - 2 * CLOSED_PI) / (4 * CLOSED_PI));
+}
+
+/* whether every joint of a and b is within `within` (joint 3 modulo 4 pi, the others modulo 2 pi) */
+static int apair_near(const double *a, const double *b, double within)
+{
+    for (int i = 0; i < 6; i++) {
+        double d = i == 2 ? wrap4(a[i] - b[i]) : closed_wrap(a[i] - b[i]);
+        if (!(fabs(d) < within)) return 0;
+    }
+    return 1;
+}
+
+/* x (verified, error err) into the solutions of one pose: one within APAIR_MULTIPLE of a kept one
+ * (a copy, or a multiple root's cluster) replaces it where its error is smaller */
+static void apair_keep(double *q, double *error, int *found, const double *x, double err)
+{
+    for (int k = 0; k < *found; k++)
+        if (apair_near(q + 6 * k, x, APAIR_MULTIPLE)) {
+            if (err < error[k]) { memcpy(q + 6 * k, x, 6 * sizeof *x); error[k] = err; }
+            return;
+        }
+    if (*found < CLOSED_APAIR_MAX) {
+        memcpy(q + 6 * *found, x, 6 * sizeof *x);
+        error[(*found)++] = err;
+    }
+}
+
+/* the candidates x (n x 6, from inner) with theta_3's representative, and their twins (theta_3 -> -theta_3)
+ * where theta_3 is near +-pi (d_3 = 0: both give the pose) appended: their count */
+static int apair_angles(const apair_design *d, double *x, int n, double l2)
+{
+    double d3 = d->p.ca[1] * l2;
+    for (int k = 0; k < n; k++) {
+        double t3 = closed_wrap(x[6 * k + 2]);
+        if (cos(0.5 * t3) * d3 < 0) t3 -= copysign(2 * CLOSED_PI, t3);
+        x[6 * k + 2] = t3;
+    }
+    int m = n;
+    for (int k = 0; k < n; k++)
+        if (fabs(fabs(x[6 * k + 2]) - CLOSED_PI) <= 1e-4) {
+            memcpy(x + 6 * m, x + 6 * k, 6 * sizeof *x);
+            x[6 * m + 2] = -x[6 * k + 2];
+            m++;
+        }
+    return m;
+}
+
+/* the smallest pose error among n candidates */
+static double apair_best(const apair_design *d, const double *Tt, const double *x, int n)
+{
+    double e[6], best = INFINITY;
+    for (int k = 0; k < n; k++) best = fmin(best, closed_evaluate(&d->p.k, d->p.dh, d->p.scale, x + 6 * k, Tt, e, NULL));
+    return best;
+}
+
+/* The candidates of one (psi_1, psi_5, psi_6): the two elbows, or the stretched (folded) one where that
+ * reproduces the pose better (near theta_3 = 0 the slide's top and the elbow's stretch meet: psi_1 is
+ * a near-double root, and the elbows' sin psi_3 = +-1e-6 from cos psi_3's error would be two spurious
+ * solutions), each polished and kept where it verifies; `continuum`: flag 1 where one does. */
+static void apair_elbows(const apair_design *d, const double *Tt, double tol, double l2, double psi1, double psi5,
+                         double psi6, int continuum, double *qj, double *ej, int *found, int *candidates, int *flags)
+{
+    const parallel_design *p = &d->p;
+    double x[24], y[24];
+    int nx = inner(p, p->dh, p->scale, Tt, psi1, psi5, psi6, x, flags, 4 * CLOSED_DOUBLE);
+    int stretched = nx == 2 && fabs(sin(x[2] + p->phi[2])) <= 1e-4;
+    nx = apair_angles(d, x, nx, l2);
+    if (stretched) {
+        int ny = apair_angles(d, y, inner(p, p->dh, p->scale, Tt, psi1, psi5, psi6, y, flags, 1.0), l2);
+        if (apair_best(d, Tt, y, ny) <= apair_best(d, Tt, x, nx)) {
+            memcpy(x, y, 6 * (size_t)ny * sizeof *x);
+            nx = ny;
+        }
+    }
+    for (int k = 0; k < nx; k++) {
+        (*candidates)++;
+        double err = closed_polish(&p->k, p->dh, p->scale, Tt, tol, x + 6 * k);
+        if (!(err <= tol)) continue;
+        for (int i = 0; i < 6; i++) x[6 * k + i] = i == 2 ? wrap4(x[6 * k + i]) : closed_wrap(x[6 * k + i]);
+        apair_keep(qj, ej, found, x + 6 * k, err);
+        if (continuum) *flags |= 1;
+    }
+}
+
+int apair_ik_parallel_apair_prepare(void *design, const double *dh, double amplitude, double scale)
+{
+    apair_design *d = (apair_design *)design;
+    parallel_design *p = &d->p;
+    if (closed_fk_init(&p->k, dh) || !(scale > 0) || !(amplitude > 0 && isfinite(amplitude)) ||
+        APAIR_IK_PARALLEL_APAIR_POSITION6_INVARIANTS > CLOSED_INV_MAX)
+        return -1;
+    memcpy(p->dh, dh, sizeof p->dh);
+    p->scale = scale;
+    for (int i = 0; i < 6; i++) { p->ca[i] = cos(dh[4 * i + 1]); p->sa[i] = sin(dh[4 * i + 1]); p->phi[i] = dh[4 * i + 3]; }
+    /* axes 2, 3, 4 parallel, UR's wrist (cos alpha_4 = cos alpha_5 = 0, a_4 = a_5 = 0), sin phi_3 = 0, a_2 a_3 != 0 */
+    if (fabs(p->sa[1]) > CLOSED_FLAT || fabs(p->sa[2]) > CLOSED_FLAT || fabs(p->ca[3]) > CLOSED_FLAT ||
+        fabs(p->ca[4]) > CLOSED_FLAT || fabs(dh[12]) > CLOSED_FLAT * scale || fabs(dh[16]) > CLOSED_FLAT * scale ||
+        fabs(sin(dh[11])) > CLOSED_FLAT || fabs(dh[4]) <= CLOSED_FLAT * scale || fabs(dh[8]) <= CLOSED_FLAT * scale)
+        return -1;
+    p->eps = p->ca[1] * p->ca[2];
+    p->P = -p->eps * p->sa[3] * p->sa[4];
+    p->Q = 0.0;
+    p->which = 1;
+    p->o3[0] = dh[12];
+    p->o3[1] = dh[14] * p->sa[3];
+    p->o3[2] = dh[14] * p->ca[3];
+    p->k.amp[2] = amplitude;
+    d->h = amplitude;
+    d->law[0] = d->law[1] = 0.5 * amplitude * amplitude; /* d_3^2 = h^2 cos^2(theta_3/2) = kappa_0 + kappa_1 cos theta_3 */
+    d->cphi3 = cos(dh[11]);
+    d->quartic = fabs(dh[18]) <= CLOSED_FLAT * scale;
+    apair_ik_parallel_apair_position6_invariants(dh, d->law, p->inv_pos);
+    return 0;
+}
+
+void apair_ik_parallel_apair_solve1(const void *design, const double *Tt, double tol, double *qj, double *ej, int *found,
+                                    int *candidates, int *flags)
+{
+    const apair_design *d = (const apair_design *)design;
+    const parallel_design *p = &d->p;
+    const double *dh = p->dh;
+    double L[6], P, gh[10], poly[13];
+    *found = *candidates = *flags = 0;
+    apair_ik_parallel_apair_position6_core(p->inv_pos, dh, Tt, d->law, L, &P, gh, poly);
+    double big = p->scale + sqrt(Tt[3] * Tt[3] + Tt[7] * Tt[7] + Tt[11] * Tt[11]);
+    double gref = big * big * (2 * fabs(dh[4] * dh[8]) + d->h * d->h); /* the size of G's terms */
+    double psi1s[CLOSED_ROOTS + 1];
+    int n1 = d->quartic ? closed_half_angles(4, gh, gref, psi1s) : closed_half_angles(12, poly, gref * gref, psi1s);
+    if (n1 < 0) { *flags = -1; return; } /* the polynomial vanishes: not separated */
+    const double *g = gh, *h = gh + 5, ca6 = p->ca[5], sa6 = p->sa[5];
+    double z5[3];
+    for (int r = 0; r < 3; r++) z5[r] = Tt[4 * r + 1] * sa6 + Tt[4 * r + 2] * ca6;
+    for (int k1 = 0; k1 < n1; k1++) {
+        double psi1 = psi1s[k1], c1 = cos(psi1), s1 = sin(psi1);
+        double l1 = L[0] + L[1] * c1 + L[2] * s1, l2 = L[3] + L[4] * c1 + L[5] * s1, c5 = l1 / P;
+        if (!(fabs(c5) <= 1 + 1e-6)) continue;
+        c5 = fmin(1.0, fmax(-1.0, c5));
+        /* G and H at psi_1 (at t = infinity, psi_1 = pi: their leading coefficients) */
+        double gv = 0.0, hv = 0.0, size = 0.0;
+        if (k1 == n1 - 1 && psi1 == CLOSED_PI) {
+            double mg = 0.0, mh = 0.0;
+            for (int k = 0; k < 5; k++) { mg = fmax(mg, fabs(g[k])); mh = fmax(mh, fabs(h[k])); }
+            gv = g[4]; hv = h[4]; size = mg + mh;
+        } else {
+            double t = tan(0.5 * psi1), pk = 1.0;
+            for (int k = 0; k < 5; k++, pk *= t) { gv += g[k] * pk; hv += h[k] * pk; size += (fabs(g[k]) + fabs(h[k])) * fabs(pk); }
+        }
+        double z1[3] = {p->sa[0] * s1, -p->sa[0] * c1, p->ca[0]}, u[3];
+        double cx = z1[1] * z5[2] - z1[2] * z5[1], cy = z1[2] * z5[0] - z1[0] * z5[2], cz = z1[0] * z5[1] - z1[1] * z5[0];
+        double psi5s[2];
+        int n5;
+        if (!d->quartic && fabs(gv) > 1e-6 * size) { /* |sin psi_5| = |z_3 x z_5| with the sign of H/G (which
+                                                       * loses digits where G and H nearly vanish) */
+            if (!(fabs(hv / gv) <= 1 + 1e-6)) continue;
+            psi5s[0] = atan2(copysign(sqrt(cx * cx + cy * cy + cz * cz), hv / gv), c5);
+            n5 = 1;
+        } else { /* G vanishes with H: both signs */
+            double base = acos(c5);
+            n5 = base <= 1e-7 || base >= CLOSED_PI - 1e-7 ? 1 : 2;
+            psi5s[0] = base <= 1e-7 ? 0.0 : base >= CLOSED_PI - 1e-7 ? CLOSED_PI : base;
+            psi5s[1] = -base;
+        }
+        for (int k = 0; k < 3; k++) u[k] = z1[0] * Tt[k] + z1[1] * Tt[4 + k] + z1[2] * Tt[8 + k];
+        double vx = p->eps * u[0], vy = p->eps * (u[1] * ca6 - u[2] * sa6);
+        for (int k5 = 0; k5 < n5; k5++) {
+            double psi5 = psi5s[k5], s5 = sin(psi5), cc5 = cos(psi5);
+            double wx = p->sa[3] * s5, wy = p->sa[3] * cc5 * p->ca[4] + p->ca[3] * p->sa[4];
+            if (hypot(wx, wy) > CLOSED_SINGULAR) {
+                apair_elbows(d, Tt, tol, l2, psi1, psi5, atan2(wy * vx - wx * vy, wx * vx + wy * vy), 0, qj, ej, found,
+                             candidates, flags);
+                continue;
+            }
+            /* axis 6 parallel to axes 2-4: the slide pins the elbow (kappa_1 cos phi_3 cos psi_3 = L_2^2 - kappa_0)
+             * and so the point of the circle frame 3's origin runs on as psi_6 turns */
+            double a2 = dh[4], a3 = dh[8], c3 = (l2 * l2 - d->law[0]) / (d->law[1] * d->cphi3), A, B, C;
+            if (!(fabs(c3) <= 1 + 1e-6)) continue;
+            circle(p, dh, Tt, psi1, psi5, &A, &B, &C);
+            double K = hypot(B, C);
+            if (!(K > CLOSED_FLAT * (a2 * a2 + a3 * a3))) { /* a point: psi_6 free, the R-arm's member */
+                apair_elbows(d, Tt, tol, l2, psi1, psi5, free_psi6(p, dh, Tt, psi1, psi5), 1, qj, ej, found, candidates,
+                             flags);
+                continue;
+            }
+            double x = (a2 * a2 + a3 * a3 + 2 * a2 * a3 * fmin(1.0, fmax(-1.0, c3)) - A) / K;
+            if (!(fabs(x) <= 1 + 1e-6)) continue;
+            double base = atan2(C, B), turn = acos(fmin(1.0, fmax(-1.0, x)));
+            apair_elbows(d, Tt, tol, l2, psi1, psi5, base + turn, 0, qj, ej, found, candidates, flags);
+            if (turn > 1e-7) apair_elbows(d, Tt, tol, l2, psi1, psi5, base - turn, 0, qj, ej, found, candidates, flags);
+        }
+    }
+    closed_sort(qj, ej, *found);
+}
+
+int apair_ik_parallel_apair(const double *dh, double amplitude, double scale, size_t count, const double *target,
+                            ptrdiff_t target_stride, double tol, double *q, double *error, int *found, int *candidates,
+                            int *flags)
+{
+    apair_ik_closed solver;
+    if (apair_ik_closed_init_apair(&solver, dh, amplitude, scale)) return -1;
     return apair_ik_closed_solve(&solver, count, target, target_stride, tol, q, error, found, candidates, flags);
 }

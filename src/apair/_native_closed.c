@@ -26,16 +26,18 @@ static void closed_dealloc(ClosedIKObject *self)
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
-/* ClosedIK(family, dh, scale, reach): family 1 (a spherical wrist) or 2 (axes 2, 3, 4 parallel), or'ed
- * with 4 where it sits at the base end (apair_ik_closed_init) */
+/* ClosedIK(family, dh, scale, reach, amplitude=0): family 1 (a spherical wrist), 2 (axes 2, 3, 4
+ * parallel) or 3 (axes 1, 2, 3 parallel, 5 and 6 meeting), or'ed with 4 where it sits at the base end
+ * (apair_ik_closed_init); or 8, a UR-like chain with a sinusoidal A-pair of that amplitude at joint 3
+ * (apair_ik_closed_init_apair) */
 static int closed_init(ClosedIKObject *self, PyObject *args, PyObject *kwds)
 {
     PyObject *dh_obj;
     PyArrayObject *dh;
-    double scale, reach;
+    double scale, reach, amplitude = 0.0;
     int family;
     (void)kwds;
-    if (!PyArg_ParseTuple(args, "iOdd", &family, &dh_obj, &scale, &reach)) {
+    if (!PyArg_ParseTuple(args, "iOdd|d", &family, &dh_obj, &scale, &reach, &amplitude)) {
         return -1;
     }
     if (self->solver != NULL) { /* call() reads the design without the GIL: it never changes */
@@ -54,7 +56,9 @@ static int closed_init(ClosedIKObject *self, PyObject *args, PyObject *kwds)
             PyErr_NoMemory();
             return -1;
         }
-        if (apair_ik_closed_init(self->solver, family, (const double *)PyArray_DATA(dh), scale)) {
+        const double *d = (const double *)PyArray_DATA(dh);
+        if (family == APAIR_IK_PARALLEL_APAIR ? apair_ik_closed_init_apair(self->solver, d, amplitude, scale)
+                                              : apair_ik_closed_init(self->solver, family, d, scale)) {
             PyMem_Free(self->solver);
             self->solver = NULL;
         }
@@ -70,7 +74,7 @@ static int closed_init(ClosedIKObject *self, PyObject *args, PyObject *kwds)
 
 static PyObject *closed_call(ClosedIKObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
-    double T[16], tol, q[48], error[8];
+    double T[16], tol, q[6 * APAIR_IK_PARALLEL_APAIR_MAX], error[APAIR_IK_PARALLEL_APAIR_MAX];
     int found = 0, candidates = 0, flags = 0, rc;
     npy_intp dims[2];
     PyObject *qa, *ea;
@@ -122,8 +126,10 @@ PyTypeObject apair_native_closed_ik_type = {
     .tp_basicsize = sizeof(ClosedIKObject),
     .tp_dealloc = (destructor)closed_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "ClosedIK(family, dh, scale, reach): the single-pose fast path of AChain.ik for chains solved in "
-              "closed form (1: a spherical wrist, 2: axes 2, 3, 4 parallel, | 4 at the base end; apair.ik.solver).",
+    .tp_doc = "ClosedIK(family, dh, scale, reach, amplitude=0): the single-pose fast path of AChain.ik for chains "
+              "solved in closed form (1: a spherical wrist, 2: axes 2, 3, 4 parallel, 3: axes 1, 2, 3 parallel with 5, 6 "
+              "meeting, | 4 at the base end; 8: a UR-like chain with an A-pair of that amplitude at joint 3; "
+              "apair.ik.solver).",
     .tp_methods = closed_methods,
     .tp_init = (initproc)closed_init,
     .tp_new = PyType_GenericNew,

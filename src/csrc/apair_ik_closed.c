@@ -1,12 +1,13 @@
 /*
- * The closed-form solvers of six-joint R-chains behind one prepared solver (apair.h: apair_ik_closed,
+ * The closed-form solvers of six-joint chains behind one prepared solver (apair.h: apair_ik_closed,
  * apair_ik_closed_init, apair_ik_closed_solve): a controller reads the design once into storage it
  * owns, then solves pose after pose; nothing is allocated. The families' own steps are in
- * apair_ik_wrist.c, apair_ik_parallel.c and apair_ik_three_parallel.c. A family at the base end (APAIR_IK_REVERSED) is the
- * reversed chain's (apair.ik.reverse): in standard DH, T^-1 = Tx(-a_6) Rx(-alpha_6) times six DH
- * joints run from the tool, joint k of them with psi' = -psi_{7-k}, c' = -c_{7-k}, a' = -a_{6-k},
- * alpha' = -alpha_{6-k} (a'_6 = alpha'_6 = 0). Hand-written C: the C backend of codegen copies it
- * into generated/c.
+ * apair_ik_wrist.c, apair_ik_parallel.c (with the UR arm with an A-pair at joint 3:
+ * apair_ik_closed_init_apair, 24 rows a pose) and apair_ik_three_parallel.c. A family at the base
+ * end (APAIR_IK_REVERSED) is the reversed chain's (apair.ik.reverse): in standard DH, T^-1 =
+ * Tx(-a_6) Rx(-alpha_6) times six DH joints run from the tool, joint k of them with psi' =
+ * -psi_{7-k}, c' = -c_{7-k}, a' = -a_{6-k}, alpha' = -alpha_{6-k} (a'_6 = alpha'_6 = 0).
+ * Hand-written C: the C backend of codegen copies it into generated/c.
  */
 #include "apair_ik_internal.h"
 
@@ -41,12 +42,25 @@ int apair_ik_closed_init(apair_ik_closed *solver, int family, const double *dh, 
     return rc;
 }
 
+int apair_ik_closed_init_apair(apair_ik_closed *solver, const double *dh, double amplitude, double scale)
+{
+    if (!solver) return -1;
+    solver->family = 0;
+    solver->scale = scale;
+    memcpy(solver->dh, dh, sizeof solver->dh);
+    if (apair_ik_parallel_apair_prepare(solver->design.d, dh, amplitude, scale)) return -1;
+    solver->family = APAIR_IK_PARALLEL_APAIR;
+    return 0;
+}
+
 /* the family's own solver at one pose T (4 x 4) */
 static void solve_form(const apair_ik_closed *solver, const double *T, double tol, double *q, double *error, int *found,
                        int *candidates, int *flags)
 {
     int form = form_of(solver->family);
-    if (form == APAIR_IK_WRIST)
+    if (form == APAIR_IK_PARALLEL_APAIR)
+        apair_ik_parallel_apair_solve1(solver->design.d, T, tol, q, error, found, candidates, flags);
+    else if (form == APAIR_IK_WRIST)
         apair_ik_wrist_solve1(solver->design.d, T, tol, q, error, found, candidates, flags);
     else if (form == APAIR_IK_PARALLEL)
         apair_ik_parallel_solve1(solver->design.d, T, tol, q, error, found, candidates, flags);
@@ -105,9 +119,10 @@ int apair_ik_closed_solve(const apair_ik_closed *solver, size_t count, const dou
                           double tol, double *q, double *error, int *found, int *candidates, int *flags)
 {
     if (!solver || !solver->family) return -1;
+    size_t rows = solver->family == APAIR_IK_PARALLEL_APAIR ? CLOSED_APAIR_MAX : CLOSED_MAX; /* per pose */
     for (size_t j = 0; j < count; j++) {
         const double *T = target + (ptrdiff_t)j * target_stride;
-        double *qj = q + 6 * CLOSED_MAX * j, *ej = error + CLOSED_MAX * j;
+        double *qj = q + 6 * rows * j, *ej = error + rows * j;
         if (solver->family & APAIR_IK_REVERSED)
             solve_reversed(solver, T, tol, qj, ej, &found[j], &candidates[j], &flags[j]);
         else

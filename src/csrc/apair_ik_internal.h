@@ -86,6 +86,10 @@ void apair_ik_wrist_solve1(const void *design, const double *T, double tol, doub
 int apair_ik_parallel_prepare(void *design, const double *dh, double scale);
 void apair_ik_parallel_solve1(const void *design, const double *T, double tol, double *q, double *error, int *found,
                               int *candidates, int *flags);
+int apair_ik_parallel_apair_prepare(void *design, const double *dh, double amplitude, double scale);
+void apair_ik_parallel_apair_solve1(const void *design, const double *T, double tol, double *q, double *error,
+                                    int *found, int *candidates, int *flags);
+#define CLOSED_APAIR_MAX APAIR_IK_PARALLEL_APAIR_MAX /* a UR arm with an A-pair at joint 3: at most 24 */
 int apair_ik_three_parallel_prepare(void *design, const double *dh, double scale);
 void apair_ik_three_parallel_solve1(const void *design, const double *T, double tol, double *q, double *error,
                                     int *found, int *candidates, int *flags);

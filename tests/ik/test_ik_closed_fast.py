@@ -1,8 +1,9 @@
 """The single-pose fast path of `ik` for the chains solved in closed form (apair._native.ClosedIK,
 set up with the chain's solver): the same numbers as the validating path on spherical-wrist, UR
-and 1∥2∥3 arms, reachable and unreachable poses; whatever it declines (other dtypes, NaN, a pose that is
-not rigid, a bad tol, full=True, frames) goes to the validating path, which answers or raises as
-before; the NumPy backend keeps its twin; a chain pickles after ik."""
+and 1∥2∥3 arms and UR designs with an A-pair at joint 3, reachable and unreachable poses; whatever
+it declines (other dtypes, NaN, a pose that is not rigid, a bad tol, full=True, frames) goes to the
+validating path, which answers or raises as before; the NumPy backend keeps its twin; a chain
+pickles after ik."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import pickle
 import numpy as np
 import pytest
 import test_ik_parallel as parallel_arms
+import test_ik_parallel_apair as apair_arms
 import test_ik_three_parallel as three_parallel_arms
 import test_ik_wrist as wrist_arms
 
@@ -25,6 +27,8 @@ def arms():
     for mod in (wrist_arms, parallel_arms, three_parallel_arms):
         for name in mod.ARMS:
             yield name, mod.arm(name)
+    for name in apair_arms.DESIGNS:  # an A-pair at joint 3 (apair_ik_closed_init_apair)
+        yield f"{name} + A-pair at joint 3", apair_arms.chain_of(name)
 
 
 @pytest.fixture(autouse=True)

@@ -1,6 +1,6 @@
-"""What the closed-form solvers of six-joint R-chains share (apair.ik.wrist, apair.ik.parallel): the
-tolerances, the real roots of their univariate polynomials and the note that names a continuum.
-Their C twins share src/csrc/apair_ik_closed.h."""
+"""What the closed-form solvers of six-joint chains share (apair.ik.wrist, apair.ik.parallel,
+apair.ik.three_parallel, apair.ik.parallel_apair): the tolerances, the real roots of their univariate
+polynomials and the note that names a continuum. Their C twins share src/csrc/apair_ik_closed.h."""
 
 from __future__ import annotations
 
@@ -28,32 +28,37 @@ def real_roots(coeffs: NDArray[np.float64], ref: float) -> tuple[list[float], bo
     if top == 0:
         return [], at_infinity
     poly = c[: top + 1][::-1]
-    roots = [_polish(poly, float(t.real)) for t in np.roots(poly) if abs(t.imag) <= ROOT_IMAG * (1 + abs(t))]
+    t = np.roots(poly)
+    roots = _polish(poly, t[np.abs(t.imag) <= ROOT_IMAG * (1 + np.abs(t))].real).tolist()
     # a critical point where the polynomial (nearly) vanishes: a double root, exact where the two
     # roots come sqrt(eps) off it (as the C twin, apair_ik_closed.h)
-    for x in np.roots(np.polyder(poly)) if top > 1 else []:
-        if abs(x.imag) <= ROOT_IMAG * (1 + abs(x)):
-            x = float(x.real)
-            if abs(np.polyval(poly, x)) <= TANGENT * max(1.0, float(np.polyval(np.abs(poly), abs(x)))):
-                roots.append(x)
+    if top > 1:
+        x = np.roots(np.polyder(poly))
+        x = x[np.abs(x.imag) <= ROOT_IMAG * (1 + np.abs(x))].real
+        near = np.abs(np.polyval(poly, x)) <= TANGENT * np.maximum(1.0, np.polyval(np.abs(poly), np.abs(x)))
+        roots += x[near].tolist()
     return roots, at_infinity
 
 
-def _polish(poly: NDArray[np.float64], x: float) -> float:
-    """Newton steps on a simple root while they shrink |p| (as the C twin's bracketed Newton): the
+def _polish(poly: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Newton steps on simple roots while they shrink |p| (as the C twin's bracketed Newton): the
     companion matrix's eigenvalues come some 1e-14 off, which a stretched elbow's cos ψ_3 = ±1
-    turns into a spurious pair of elbows 1e-6 apart."""
+    turns into a spurious pair of elbows 1e-6 apart. Each root stops at its first step that does
+    not shrink |p|."""
     dpoly = np.polyder(poly)
-    px = abs(float(np.polyval(poly, x)))
+    x = np.array(x, dtype=np.float64)
+    px = np.abs(np.polyval(poly, x))
+    going = np.ones(len(x), dtype=bool)
     for _ in range(3):
-        d = float(np.polyval(dpoly, x))
-        if d == 0.0 or px == 0.0:
+        d = np.polyval(dpoly, x)
+        going &= (d != 0.0) & (px != 0.0)
+        if not going.any():
             break
-        y = x - float(np.polyval(poly, x)) / d
-        py = abs(float(np.polyval(poly, y)))
-        if not py < px:
-            break
-        x, px = y, py
+        with np.errstate(divide="ignore", invalid="ignore"):
+            y = np.where(going, x - np.polyval(poly, x) / np.where(going, d, 1.0), x)
+        py = np.abs(np.polyval(poly, y))
+        going &= py < px
+        x, px = np.where(going, y, x), np.where(going, py, px)
     return x
 
 

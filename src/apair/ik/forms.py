@@ -1,14 +1,15 @@
-"""Which closed form solves a six-joint R-chain (issue 42): its family's (apair.ik.wrist,
-apair.ik.parallel, apair.ik.three_parallel), at the tool end or, for a family at the base end, the
-reversed chain's (apair.ik.reverse); None where the chain has none (the general solvers answer)."""
+"""Which closed form solves a six-joint chain (issue 42): its family's (apair.ik.wrist,
+apair.ik.parallel, apair.ik.three_parallel; apair.ik.parallel_apair for a UR-like arm with an A-pair
+at joint 3), at the tool end or, for an R-chain's family at the base end, the reversed chain's
+(apair.ik.reverse); None where the chain has none (the general solvers answer)."""
 
 from __future__ import annotations
 
-from . import parallel, three_parallel, wrist
+from . import parallel, parallel_apair, three_parallel, wrist
 from .families import Classification, classify
 from .reverse import Reversed, ReversedView
 
-Forward = wrist.Wrist | parallel.Parallel | three_parallel.ThreeParallel
+Forward = wrist.Wrist | parallel.Parallel | three_parallel.ThreeParallel | parallel_apair.ParallelAPair
 Form = Forward | Reversed
 
 
@@ -16,11 +17,15 @@ def forward_form(chain, family: Classification, scale: float) -> Forward | None:
     """The closed-form solver of a chain's forward family (`family`: classify(chain))."""
     if wrist.applies(chain, family):
         return wrist.Wrist(chain, scale)
-    for module, make in ((parallel, parallel.Parallel), (three_parallel, three_parallel.ThreeParallel)):
+    for module, make in (
+        (parallel, parallel.Parallel),
+        (three_parallel, three_parallel.ThreeParallel),
+        (parallel_apair, parallel_apair.ParallelAPair),
+    ):
         if module.applies(chain, family):
             try:
                 return make(chain, scale)
-            except ValueError:  # a design the closed form does not cover (e.g. axes 5 and 6 one line)
+            except ValueError:  # a design the form does not cover (axes 5 and 6 one line, not UR's wrist, ...)
                 return None
     return None
 

@@ -57,6 +57,7 @@ class Parallel:
     """The closed form of one chain: its design read once."""
 
     code = 2  # the family in apair.h (APAIR_IK_PARALLEL)
+    amplitude = 0.0  # of an A-pair at joint 3 (apair.ik.parallel_apair)
     flags = FLAGS  # the continua its C form flags, by bit
 
     def __init__(self, chain, scale: float) -> None:
@@ -158,14 +159,18 @@ class Parallel:
         """Where ψ_6 is free, frame 3's origin runs on a circle as ψ_6 turns, ρ² = A + B cos ψ_6 +
         C sin ψ_6: the member with the elbow at cos ψ_3 = 0 (ρ² = a_2² + a_3²) where the circle
         reaches it, else the nearest."""
-        r = [float(np.sum(self._frame3(psi1, psi5, k * math.pi / 2, Tm)[1] ** 2)) for k in range(3)]
-        A, B = 0.5 * (r[0] + r[2]), 0.5 * (r[0] - r[2])
-        C = r[1] - A
+        A, B, C = self._circle(psi1, psi5, Tm)
         K = math.hypot(B, C)
         mid = self.dh[1, 0] ** 2 + self.dh[2, 0] ** 2
         if not K > FLAT * mid:
             return 0.0
         return math.atan2(C, B) + math.acos(max(-1.0, min(1.0, (mid - A) / K)))
+
+    def _circle(self, psi1: float, psi5: float, Tm) -> tuple[float, float, float]:
+        """(A, B, C) of ρ² = A + B cos ψ_6 + C sin ψ_6, frame 3's distance from axis 2 as ψ_6 turns."""
+        r = [float(np.sum(self._frame3(psi1, psi5, k * math.pi / 2, Tm)[1] ** 2)) for k in range(3)]
+        A, B = 0.5 * (r[0] + r[2]), 0.5 * (r[0] - r[2])
+        return A, B, r[1] - A
 
     def _frame3(self, psi1: float, psi5: float, psi6: float, Tm) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """N = A_2 A_3 A_4 and frame 3's origin's (x, y) in frame 1."""
@@ -176,8 +181,11 @@ class Parallel:
         N = np.linalg.solve(A1, Tm @ np.linalg.inv(A6) @ np.linalg.inv(A5))
         return N, (N[:3, 3] - N[:3, :3] @ self.o3)[:2]
 
-    def _inner(self, psi1: float, psi5: float, psi6: float, Tm, free: set[str]) -> list[list[float]]:
-        """ψ_2, ψ_3, ψ_4 of the planar 3R problem left by ψ_1, ψ_5, ψ_6: [ψ_1 … ψ_6] per elbow."""
+    def _inner(
+        self, psi1: float, psi5: float, psi6: float, Tm, free: set[str], stretched: float = DOUBLE * 4
+    ) -> list[list[float]]:
+        """ψ_2, ψ_3, ψ_4 of the planar 3R problem left by ψ_1, ψ_5, ψ_6: [ψ_1 … ψ_6] per elbow (one,
+        the stretched or folded elbow, where sin² ψ_3 ≤ `stretched`)."""
         d = self.dh
         N, O3 = self._frame3(psi1, psi5, psi6, Tm)
         a2, a3 = d[1, 0], d[2, 0]
@@ -186,7 +194,7 @@ class Parallel:
         if abs(c3) > 1 + 1e-6:
             return []
         rest = 1 - c3 * c3
-        s3 = 0.0 if rest <= DOUBLE * 4 else math.sqrt(max(0.0, rest))
+        s3 = 0.0 if rest <= stretched else math.sqrt(max(0.0, rest))
         out = []
         for sign in (1.0, -1.0) if s3 > 0 else (1.0,):
             psi3 = math.atan2(sign * s3, c3)

@@ -333,7 +333,7 @@ def _fast_path(closed: Form | None, scale: float, reach: float) -> Any:
     if closed is None or native is None:
         return None
     try:
-        return native.ClosedIK(closed.code, closed.dh, scale, reach)
+        return native.ClosedIK(closed.code, closed.dh, scale, reach, closed.amplitude)
     except ValueError:  # a design its C form does not prepare: the validating path answers
         return None
 

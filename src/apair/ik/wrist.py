@@ -64,6 +64,7 @@ class Wrist:
     """The closed form of one chain: its design read once."""
 
     code = 1  # the family in apair.h (APAIR_IK_WRIST)
+    amplitude = 0.0  # (every joint an R-pair)
     flags = FLAGS  # the continua its C form flags, by bit
 
     def __init__(self, chain, scale: float) -> None:
