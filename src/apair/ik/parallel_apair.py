@@ -131,8 +131,8 @@ class ParallelAPair(Parallel):
                 elif (pinned := self._pinned_psi6(psi1, psi5, Tm, l2)) is not None:
                     for psi6 in pinned:
                         found += self._elbows(psi1, psi5, psi6, Tm, free, l2)
-                else:  # ψ_6 free: the member with the elbow mid-range
-                    found = self._inner(psi1, psi5, self._free_psi6(psi1, psi5, Tm), Tm, free)
+                else:  # ψ_6 free: the member with the elbow mid-range (as the C twin, apair_elbows)
+                    found = self._elbows(psi1, psi5, self._free_psi6(psi1, psi5, Tm), Tm, free, l2)
                     if len(refine(self.chain, self._angles(found, l2), Tm, tol, self.scale)[0]):
                         free.add(FLAGS[1])
                 out += self._angles(found, l2).tolist()
