@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 963347a4ac0efa69
+Content hash: fe33eaad017dd2c7
 """

@@ -1,6 +1,7 @@
 /*
  * Private to the closed-form solvers of six-joint chains (apair_ik_wrist.c, apair_ik_parallel.c with
- * its UR arm with an A-pair at joint 3, apair_ik_three_parallel.c; their Python twins share apair.ik.closed): the real roots of their univariate polynomials, the DH
+ * its UR arm with an A-pair at joint 3, apair_ik_three_parallel.c; their Python twins share
+ * apair.ik.closed): the real roots of their univariate polynomials, the DH
  * joint transform, fk with the pose error, the Gauss-Newton polish, and the merged, sorted set of
  * verified solutions. Static functions: each solver's file gets its own copy to inline.
  */
@@ -131,8 +132,8 @@ static int closed_real_roots(int d, const double *c, double *roots)
     return n;
 }
 
-/* The angles psi = 2 atan t of the real roots t of sum c_k t^k (degree deg <= CLOSED_DEGREE; psi = pi where the
- * degree drops: the root at t = infinity) into psi (room for CLOSED_ROOTS + 1): their count, or -1
+/* The angles psi = 2 atan t of the real roots t of sum c_k t^k (degree deg <= CLOSED_DEGREE; psi = pi
+ * where the degree drops: the root at t = infinity) into psi (room for CLOSED_ROOTS + 1): their count, or -1
  * where every coefficient is below CLOSED_FLAT ref, the size of its terms (psi then moves nothing
  * the polynomial sees: not separated). */
 static inline int closed_half_angles(int deg, const double *c, double ref, double *psi)
