@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: fe33eaad017dd2c7
+Content hash: a9e0c1ccc788bfcc
 """
