@@ -37,6 +37,7 @@ DERIVATIONS = (
     "chain_ik_parallel",
     "chain_ik_three_parallel",
     "chain_ik_parallel_apair",
+    "chain_ik_wrist_apair",
 )
 # The derivations whose kernels a derivation's kernels call (`Call`): --only runs them too.
 NEEDS = {"chain_dynamics_derivatives": ("chain_dynamics",)}
@@ -66,6 +67,7 @@ COST = {
     ("chain_ik_parallel", None): 2,
     ("chain_ik_three_parallel", None): 1,
     ("chain_ik_parallel_apair", None): 2,
+    ("chain_ik_wrist_apair", None): 2,
 }
 
 

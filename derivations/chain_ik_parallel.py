@@ -132,11 +132,14 @@ def spec() -> KernelSpec:
 def check(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> float:
     """Largest relative residual of L_1 − P cos ψ_5, L_2 − Q sin ψ_5 and of the polynomials at
     t = tan(ψ_1/2), at poses of random designs with axes 2, 3, 4 parallel (α_2, α_3 ∈ {0, π};
-    general, a_5 = 0, α_5 = 0) built by the mpmath DH product."""
+    general, a_5 = 0, α_5 = 0) built by the mpmath DH product. The case "slides" (cos α_1 =
+    cos α_4 = 0, a_5 = 0: the UR arms) builds the pose with slides d_1, d_5 added to c_1 and c_5 and
+    feeds the kernel the design without them: A-pairs at joints 1 and 5 leave the first step as it
+    is (apair.ik.parallel_slides)."""
     rng = random.Random(42)
     worst = 0.0
     with mpmath.workdps(digits):
-        for case in ("general", "a5=0", "alpha5=0") * samples:
+        for case in ("general", "a5=0", "alpha5=0", "slides") * samples:
             dh = [[mpmath.mpf(rng.uniform(0.1, 1)), mpmath.mpf(rng.uniform(-3, 3)), mpmath.mpf(rng.uniform(-1, 1)),
                    mpmath.mpf(rng.uniform(-3, 3))] for _ in range(6)]  # fmt: skip
             dh[1][1], dh[2][1] = mpmath.pi * rng.randint(0, 1), mpmath.pi * rng.randint(0, 1)  # 2∥3∥4
@@ -144,10 +147,15 @@ def check(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> float:
                 dh[4][0] = mpmath.mpf(0)
             if case == "alpha5=0":
                 dh[4][1] = mpmath.mpf(0)
+            slide = [mpmath.mpf(0)] * 6
+            if case == "slides":
+                dh[0][1], dh[3][1] = mpmath.pi / 2 * rng.choice((-1, 1)), mpmath.pi / 2 * rng.choice((-1, 1))
+                dh[4][0] = mpmath.mpf(0)
+                slide[0], slide[4] = mpmath.mpf(rng.uniform(-1, 1)), mpmath.mpf(rng.uniform(-1, 1))
             psi = [mpmath.mpf(rng.uniform(-3, 3)) for _ in range(6)]
             T = mpmath.eye(4)
             for i in range(6):
-                T = T * _mp_dh(psi[i], 0, dh[i][0], dh[i][1], dh[i][2], 0)
+                T = T * _mp_dh(psi[i], 0, dh[i][0], dh[i][1], dh[i][2] + slide[i], 0)
             env = {s: sp.Float(x, digits) for s, x in zip(kernel.inputs[0].symbols, [x for row in dh for x in row])}
             env.update({s: sp.Float(T[k // 4, k % 4], digits) for k, s in enumerate(kernel.inputs[1].symbols)})
             for s, e in kernel.steps:
@@ -161,7 +169,9 @@ def check(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> float:
             t = mpmath.tan(psi[0] / 2)
             value = lambda cs: sum(c * t**k for k, c in enumerate(cs))
             scale = lambda cs: sum(abs(c) * abs(t) ** k for k, c in enumerate(cs)) + 1
-            polys = {"general": [quartic], "a5=0": [quartic, qb], "alpha5=0": [quartic, qa]}[case]
+            polys = {"general": [quartic], "a5=0": [quartic, qb], "alpha5=0": [quartic, qa], "slides": [quartic, qb]}[
+                case
+            ]
             for cs in polys:
                 worst = max(worst, float(abs(value(cs)) / scale(cs)))
     assert worst < 1e-30, f"ik_parallel_position6: an equation fails at a pose by {worst}"

@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: a9e0c1ccc788bfcc
+Content hash: d3341f82ae451eb8
 """

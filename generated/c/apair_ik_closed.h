@@ -1,10 +1,10 @@
 /*
  * A copy of src/csrc/apair_ik_closed.h (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_closed.h. Content hash: 80528ee2c59de847
+ * generated/c. Do not edit: edit src/csrc/apair_ik_closed.h. Content hash: 7fc95bbb4c374768
  */
 /*
- * Private to the closed-form solvers of six-joint chains (apair_ik_wrist.c, apair_ik_parallel.c with
- * its UR arm with an A-pair at joint 3, apair_ik_three_parallel.c; their Python twins share
+ * Private to the closed-form solvers of six-joint chains (apair_ik_wrist.c, apair_ik_parallel.c,
+ * apair_ik_three_parallel.c, with the A-pair arms' forms in the first two; their Python twins share
  * apair.ik.closed): the real roots of their univariate polynomials, the DH
  * joint transform, fk with the pose error, the Gauss-Newton polish, and the merged, sorted set of
  * verified solutions. Static functions: each solver's file gets its own copy to inline.
@@ -230,6 +230,42 @@ static void closed_keep(double *q, double *error, int *found, const double *x, d
             return;
         }
     if (*found < CLOSED_MAX) {
+        memcpy(q + 6 * *found, x, 6 * sizeof *x);
+        error[(*found)++] = err;
+    }
+}
+
+/* The A-pair arms' closed forms (apair_ik_parallel.c, apair_ik_wrist.c): an A-pair's angle has period
+ * 4 pi (its slide changes sign at theta + 2 pi), and at a singular pose the roots come sqrt(eps) apart
+ * and verify as a cluster around the exact solution. */
+#define CLOSED_MULTIPLE 1e-4 /* [rad] verified solutions this close are one (a multiple root's cluster) */
+
+static inline double closed_wrap4(double x) /* into (-2 pi, 2 pi], an A-pair's angle */
+{
+    return x - 4 * CLOSED_PI * ceil((x - 2 * CLOSED_PI) / (4 * CLOSED_PI));
+}
+
+/* whether every joint of a and b is within `within` (an A-pair's, amp[i] != 0, modulo 4 pi, the others modulo 2 pi) */
+static inline int closed_apair_near(const double *amp, const double *a, const double *b, double within)
+{
+    for (int i = 0; i < 6; i++) {
+        double d = amp[i] != 0.0 ? closed_wrap4(a[i] - b[i]) : closed_wrap(a[i] - b[i]);
+        if (!(fabs(d) < within)) return 0;
+    }
+    return 1;
+}
+
+/* x (verified, error err) into the solutions of one pose: one within CLOSED_MULTIPLE of a kept one
+ * (a copy, or a multiple root's cluster) replaces it where its error is smaller; at most
+ * CLOSED_APAIR_MAX kept */
+static inline void closed_apair_keep(const double *amp, double *q, double *error, int *found, const double *x, double err)
+{
+    for (int k = 0; k < *found; k++)
+        if (closed_apair_near(amp, q + 6 * k, x, CLOSED_MULTIPLE)) {
+            if (err < error[k]) { memcpy(q + 6 * k, x, 6 * sizeof *x); error[k] = err; }
+            return;
+        }
+    if (*found < CLOSED_APAIR_MAX) {
         memcpy(q + 6 * *found, x, 6 * sizeof *x);
         error[(*found)++] = err;
     }

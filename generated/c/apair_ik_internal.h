@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_internal.h (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_internal.h. Content hash: e0ab7cfb791aa057
+ * generated/c. Do not edit: edit src/csrc/apair_ik_internal.h. Content hash: 4dad18ebf79d409b
  */
 /*
  * Private to the hand-written solvers of src/csrc (apair_ik_*.c, apair_ik4.c, apair_ik6r.c): the
@@ -93,7 +93,17 @@ void apair_ik_parallel_solve1(const void *design, const double *T, double tol, d
 int apair_ik_parallel_apair_prepare(void *design, const double *dh, double amplitude, double scale);
 void apair_ik_parallel_apair_solve1(const void *design, const double *T, double tol, double *q, double *error,
                                     int *found, int *candidates, int *flags);
-#define CLOSED_APAIR_MAX APAIR_IK_PARALLEL_APAIR_MAX /* a UR arm with an A-pair at joint 3: at most 24 */
+int apair_ik_parallel_slides_prepare(void *design, const double *dh, const double *amplitude, double scale);
+void apair_ik_parallel_slides_solve1(const void *design, const double *T, double tol, double *q, double *error,
+                                     int *found, int *candidates, int *flags);
+int apair_ik_wrist_apair_prepare(void *design, const double *dh, double amplitude, double scale);
+void apair_ik_wrist_apair_solve1(const void *design, const double *T, double tol, double *q, double *error, int *found,
+                                 int *candidates, int *flags);
+int apair_ik_wrist_slide1_prepare(void *design, const double *dh, double amplitude, double scale);
+void apair_ik_wrist_slide1_solve1(const void *design, const double *T, double tol, double *q, double *error, int *found,
+                                  int *candidates, int *flags);
+/* the A-pair arms: at most 24 (UR, joint 3), 32 (UR, joints 1 and 5), 16 (a wrist, joint 3 or 1) */
+#define CLOSED_APAIR_MAX APAIR_IK_APAIR_MAX
 int apair_ik_three_parallel_prepare(void *design, const double *dh, double scale);
 void apair_ik_three_parallel_solve1(const void *design, const double *T, double tol, double *q, double *error,
                                     int *found, int *candidates, int *flags);

@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_parallel.c (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_parallel.c. Content hash: f60f11a7c8842213
+ * generated/c. Do not edit: edit src/csrc/apair_ik_parallel.c. Content hash: 0be31a9e224d195b
  */
 /*
  * The closed-form inverse kinematics of six-joint R-chains with axes 2, 3 and 4 parallel (UR arms;
@@ -159,20 +159,26 @@ int apair_ik_parallel_prepare(void *design, const double *dh, double scale)
     return 0;
 }
 
+/* The first step at pose T: L (L_1, L_2 in (1, cos psi_1, sin psi_1)) and psi_1 at the real roots of the
+ * design's polynomial (room for CLOSED_ROOTS + 1); their count, or -1 where it vanishes identically */
+static int first_step(const parallel_design *p, const double *Tt, double *L, double *psi1s)
+{
+    double PQ[2], quartic[5], qa[3], qb[3];
+    apair_ik_parallel_position6_core(p->inv_pos, p->dh, Tt, L, PQ, quartic, qa, qb);
+    const double *c = p->which == 0 ? quartic : p->which == 1 ? qb : qa;
+    double big = p->scale + sqrt(Tt[3] * Tt[3] + Tt[7] * Tt[7] + Tt[11] * Tt[11]);
+    double ref = p->which == 0 ? (big * p->P) * (big * p->P) + p->Q * p->Q : p->which == 1 ? big : 1.0;
+    return closed_half_angles(p->which == 0 ? 4 : 2, c, ref, psi1s);
+}
+
 void apair_ik_parallel_solve1(const void *design, const double *Tt, double tol, double *qj, double *ej, int *found,
                               int *candidates, int *flags)
 {
     const parallel_design *p = (const parallel_design *)design;
     const double *dh = p->dh, eps = p->eps;
-    double scale = p->scale, L[6], PQ[2], quartic[5], qa[3], qb[3];
+    double scale = p->scale, L[6], psi1s[CLOSED_ROOTS + 1];
     *found = *candidates = *flags = 0;
-    apair_ik_parallel_position6_core(p->inv_pos, dh, Tt, L, PQ, quartic, qa, qb);
-    const double *c = p->which == 0 ? quartic : p->which == 1 ? qb : qa;
-    int deg = p->which == 0 ? 4 : 2;
-    double big = scale + sqrt(Tt[3] * Tt[3] + Tt[7] * Tt[7] + Tt[11] * Tt[11]);
-    double ref = p->which == 0 ? (big * p->P) * (big * p->P) + p->Q * p->Q : p->which == 1 ? big : 1.0;
-    double psi1s[CLOSED_ROOTS + 1];
-    int n1 = closed_half_angles(deg, c, ref, psi1s);
+    int n1 = first_step(p, Tt, L, psi1s);
     if (n1 < 0) { *flags = -1; return; } /* the polynomial vanishes: not separated */
     double z5[3], ca6 = p->ca[5], sa6 = p->sa[5];
     for (int r = 0; r < 3; r++) z5[r] = Tt[4 * r + 1] * sa6 + Tt[4 * r + 2] * ca6;
@@ -220,8 +226,6 @@ int apair_ik_parallel(const double *dh, double scale, size_t count, const double
  * and psi_4 as on the R-arm above; theta_3 is the angle in (-2 pi, 2 pi] whose slide h cos(theta_3/2)
  * has the sign of cos alpha_2 L_2, with its twin where it is near +-pi. */
 
-#define APAIR_MULTIPLE 1e-4 /* [rad] verified solutions this close are one (a multiple root's cluster) */
-
 typedef struct {
     parallel_design p; /* the R-arm's steps; its inv_pos holds ik_parallel_apair_position6's invariants */
     double law[2], h, cphi3;
@@ -230,36 +234,6 @@ typedef struct {
 
 /* the prepared design lives in apair_ik_closed's storage */
 typedef char apair_design_fits[sizeof(apair_design) <= sizeof(((apair_ik_closed *)0)->design) ? 1 : -1];
-
-static double wrap4(double x) /* into (-2 pi, 2 pi], an A-pair's angle */
-{
-    return x - 4 * CLOSED_PI * ceil((x - 2 * CLOSED_PI) / (4 * CLOSED_PI));
-}
-
-/* whether every joint of a and b is within `within` (joint 3 modulo 4 pi, the others modulo 2 pi) */
-static int apair_near(const double *a, const double *b, double within)
-{
-    for (int i = 0; i < 6; i++) {
-        double d = i == 2 ? wrap4(a[i] - b[i]) : closed_wrap(a[i] - b[i]);
-        if (!(fabs(d) < within)) return 0;
-    }
-    return 1;
-}
-
-/* x (verified, error err) into the solutions of one pose: one within APAIR_MULTIPLE of a kept one
- * (a copy, or a multiple root's cluster) replaces it where its error is smaller */
-static void apair_keep(double *q, double *error, int *found, const double *x, double err)
-{
-    for (int k = 0; k < *found; k++)
-        if (apair_near(q + 6 * k, x, APAIR_MULTIPLE)) {
-            if (err < error[k]) { memcpy(q + 6 * k, x, 6 * sizeof *x); error[k] = err; }
-            return;
-        }
-    if (*found < CLOSED_APAIR_MAX) {
-        memcpy(q + 6 * *found, x, 6 * sizeof *x);
-        error[(*found)++] = err;
-    }
-}
 
 /* the candidates x (n x 6, from inner) with theta_3's representative, and their twins (theta_3 -> -theta_3)
  * where theta_3 is near +-pi (d_3 = 0: both give the pose) appended: their count */
@@ -312,8 +286,8 @@ static void apair_elbows(const apair_design *d, const double *Tt, double tol, do
         (*candidates)++;
         double err = closed_polish(&p->k, p->dh, p->scale, Tt, tol, x + 6 * k);
         if (!(err <= tol)) continue;
-        for (int i = 0; i < 6; i++) x[6 * k + i] = i == 2 ? wrap4(x[6 * k + i]) : closed_wrap(x[6 * k + i]);
-        apair_keep(qj, ej, found, x + 6 * k, err);
+        for (int i = 0; i < 6; i++) x[6 * k + i] = i == 2 ? closed_wrap4(x[6 * k + i]) : closed_wrap(x[6 * k + i]);
+        closed_apair_keep(p->k.amp, qj, ej, found, x + 6 * k, err);
         if (continuum) *flags |= 1;
     }
 }
@@ -427,11 +401,97 @@ void apair_ik_parallel_apair_solve1(const void *design, const double *Tt, double
     closed_sort(qj, ej, *found);
 }
 
-int apair_ik_parallel_apair(const double *dh, double amplitude, double scale, size_t count, const double *target,
-                            ptrdiff_t target_stride, double tol, double *q, double *error, int *found, int *candidates,
-                            int *flags)
+/* ---- A UR-like arm with sinusoidal A-pairs at joint 1 (cos alpha_1 = 0) and/or joint 5 (cos alpha_4 = 0)
+ * (apair.ik.parallel_slides, where the steps are explained): their slides run along axes at right
+ * angles to the parallel axes 2-4, so L_1 and L_2 of the R-arm's first step do not see them
+ * (derivations/chain_ik_parallel.py checks it) and psi_1 and psi_5 come as on the R-arm. Each of those
+ * angles has two representatives theta in (-2 pi, 2 pi], the pair's slides h cos(theta/2) of
+ * opposite signs; for each the R-arm's remaining steps run with c_1 + d_1 and c_5 + d_5: at most
+ * 8 x 2 x 2 = 32 solutions. The design is the R-arm's (parallel_design) with the amplitudes in
+ * k.amp, so the polish and the verification carry the pairs' laws. */
+
+/* the representatives in (-2 pi, 2 pi] of a joint's angle from psi (mod 2 pi): theta, and for an
+ * A-pair (amp != 0) theta -+ 2 pi too; their count */
+static int slides_reps(double psi, double phi, double amp, double *theta)
+{
+    double t = closed_wrap(psi - phi);
+    theta[0] = t;
+    if (amp == 0.0) return 1;
+    theta[1] = closed_wrap4(t - copysign(2 * CLOSED_PI, t));
+    return 2;
+}
+
+int apair_ik_parallel_slides_prepare(void *design, const double *dh, const double *amplitude, double scale)
+{
+    parallel_design *p = (parallel_design *)design;
+    if (apair_ik_parallel_prepare(design, dh, scale)) return -1;
+    int any = 0;
+    for (int i = 0; i < 6; i++) {
+        if (!(amplitude[i] >= 0.0 && isfinite(amplitude[i]))) return -1;
+        if (amplitude[i] == 0.0) continue;
+        /* only joints 1 and 5, each sliding at right angles to the parallel axes */
+        if ((i != 0 && i != 4) || fabs(p->ca[i == 0 ? 0 : 3]) > CLOSED_FLAT) return -1;
+        p->k.amp[i] = amplitude[i];
+        any = 1;
+    }
+    return any ? 0 : -1;
+}
+
+void apair_ik_parallel_slides_solve1(const void *design, const double *Tt, double tol, double *qj, double *ej,
+                                     int *found, int *candidates, int *flags)
+{
+    const parallel_design *p = (const parallel_design *)design;
+    const double *amp = p->k.amp, eps = p->eps;
+    double scale = p->scale, L[6], psi1s[CLOSED_ROOTS + 1];
+    *found = *candidates = *flags = 0;
+    int n1 = first_step(p, Tt, L, psi1s);
+    if (n1 < 0) { *flags = -1; return; } /* the polynomial vanishes: not separated */
+    double z5[3], ca6 = p->ca[5], sa6 = p->sa[5], dh[24];
+    for (int r = 0; r < 3; r++) z5[r] = Tt[4 * r + 1] * sa6 + Tt[4 * r + 2] * ca6;
+    memcpy(dh, p->dh, sizeof dh);
+    for (int k1 = 0; k1 < n1; k1++) {
+        double psi1 = psi1s[k1], c1 = cos(psi1), s1 = sin(psi1);
+        double l1 = L[0] + L[1] * c1 + L[2] * s1, l2 = L[3] + L[4] * c1 + L[5] * s1;
+        double z1[3] = {p->sa[0] * s1, -p->sa[0] * c1, p->ca[0]}, psi5s[2], u[3], th1[2], th5[2];
+        int n5 = psi5_of(p, l1, l2, z1, z5, psi5s), m1 = slides_reps(psi1, p->phi[0], amp[0], th1);
+        for (int k = 0; k < 3; k++) u[k] = z1[0] * Tt[k] + z1[1] * Tt[4 + k] + z1[2] * Tt[8 + k];
+        double vx = eps * u[0], vy = eps * (u[1] * ca6 - u[2] * sa6);
+        for (int k5 = 0; k5 < n5; k5++) {
+            double psi5 = psi5s[k5], s5 = sin(psi5), cc5 = cos(psi5);
+            double wx = p->sa[3] * s5, wy = p->sa[3] * cc5 * p->ca[4] + p->ca[3] * p->sa[4];
+            int singular = hypot(wx, wy) <= CLOSED_SINGULAR; /* axis 6 parallel to axes 2-4: psi_6 free */
+            int m5 = slides_reps(psi5, p->phi[4], amp[4], th5);
+            for (int j1 = 0; j1 < m1; j1++)
+                for (int j5 = 0; j5 < m5; j5++) {
+                    dh[2] = p->dh[2] + amp[0] * cos(0.5 * th1[j1]); /* c_1 + d_1, c_5 + d_5 */
+                    dh[18] = p->dh[18] + amp[4] * cos(0.5 * th5[j5]);
+                    double psi6 = singular ? free_psi6(p, dh, Tt, psi1, psi5)
+                                           : atan2(wy * vx - wx * vy, wx * vx + wy * vy), x[12];
+                    int nx = inner(p, dh, scale, Tt, psi1, psi5, psi6, x, flags, 4 * CLOSED_DOUBLE);
+                    for (int k = 0; k < nx; k++) {
+                        double *xk = x + 6 * k;
+                        xk[0] = th1[j1];
+                        xk[4] = th5[j5];
+                        (*candidates)++;
+                        double err = closed_polish(&p->k, p->dh, scale, Tt, tol, xk);
+                        if (!(err <= tol)) continue;
+                        for (int i = 0; i < 6; i++) xk[i] = amp[i] != 0.0 ? closed_wrap4(xk[i]) : closed_wrap(xk[i]);
+                        closed_apair_keep(amp, qj, ej, found, xk, err);
+                        if (singular) *flags |= 1;
+                    }
+                }
+        }
+    }
+    closed_sort(qj, ej, *found);
+}
+
+int apair_ik_parallel_apair(const double *dh, const double *amplitude, double scale, size_t count,
+                            const double *target, ptrdiff_t target_stride, double tol, double *q, double *error,
+                            int *found, int *candidates, int *flags)
 {
     apair_ik_closed solver;
-    if (apair_ik_closed_init_apair(&solver, dh, amplitude, scale)) return -1;
+    if (apair_ik_closed_init_apair(&solver, dh, amplitude, scale) ||
+        (solver.family != APAIR_IK_PARALLEL_APAIR && solver.family != APAIR_IK_PARALLEL_SLIDES))
+        return -1;
     return apair_ik_closed_solve(&solver, count, target, target_stride, tol, q, error, found, candidates, flags);
 }

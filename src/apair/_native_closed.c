@@ -26,19 +26,33 @@ static void closed_dealloc(ClosedIKObject *self)
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
-/* ClosedIK(family, dh, scale, reach, amplitude=0): family 1 (a spherical wrist), 2 (axes 2, 3, 4
+/* ClosedIK(family, dh, scale, reach, amplitude=None): family 1 (a spherical wrist), 2 (axes 2, 3, 4
  * parallel) or 3 (axes 1, 2, 3 parallel, 5 and 6 meeting), or'ed with 4 where it sits at the base end
- * (apair_ik_closed_init); or 8, a UR-like chain with a sinusoidal A-pair of that amplitude at joint 3
- * (apair_ik_closed_init_apair) */
+ * (apair_ik_closed_init); or 8 or 16, a UR-like chain with sinusoidal A-pairs of amplitudes
+ * amplitude (6,) at joint 3, or at joints 1 and 5, or 32 and 64, a spherical wrist's with one at
+ * joint 3, or at joint 1 (apair_ik_closed_init_apair) */
 static int closed_init(ClosedIKObject *self, PyObject *args, PyObject *kwds)
 {
-    PyObject *dh_obj;
-    PyArrayObject *dh;
-    double scale, reach, amplitude = 0.0;
-    int family;
+    PyObject *dh_obj, *amp_obj = Py_None;
+    PyArrayObject *dh, *amp = NULL;
+    double scale, reach;
+    int family, apairs;
     (void)kwds;
-    if (!PyArg_ParseTuple(args, "iOdd|d", &family, &dh_obj, &scale, &reach, &amplitude)) {
+    if (!PyArg_ParseTuple(args, "iOdd|O", &family, &dh_obj, &scale, &reach, &amp_obj)) {
         return -1;
+    }
+    apairs = family == APAIR_IK_PARALLEL_APAIR || family == APAIR_IK_PARALLEL_SLIDES || family == APAIR_IK_WRIST_APAIR ||
+             family == APAIR_IK_WRIST_SLIDES;
+    if (apairs) {
+        amp = (PyArrayObject *)PyArray_FROM_OTF(amp_obj, NPY_DOUBLE, NPY_ARRAY_IN_ARRAY);
+        if (amp == NULL) {
+            return -1;
+        }
+        if (PyArray_NDIM(amp) != 1 || PyArray_DIM(amp, 0) != 6) {
+            Py_DECREF(amp);
+            PyErr_SetString(PyExc_ValueError, "ClosedIK: amplitude (6,) for the A-pair families");
+            return -1;
+        }
     }
     if (self->solver != NULL) { /* call() reads the design without the GIL: it never changes */
         PyErr_SetString(PyExc_TypeError, "ClosedIK: already initialised");
@@ -46,6 +60,7 @@ static int closed_init(ClosedIKObject *self, PyObject *args, PyObject *kwds)
     }
     dh = (PyArrayObject *)PyArray_FROM_OTF(dh_obj, NPY_DOUBLE, NPY_ARRAY_IN_ARRAY);
     if (dh == NULL) {
+        Py_XDECREF(amp);
         return -1;
     }
     if (PyArray_NDIM(dh) == 2 && PyArray_DIM(dh, 0) == 6 && PyArray_DIM(dh, 1) == 4 && scale > 0 && isfinite(scale) &&
@@ -57,13 +72,15 @@ static int closed_init(ClosedIKObject *self, PyObject *args, PyObject *kwds)
             return -1;
         }
         const double *d = (const double *)PyArray_DATA(dh);
-        if (family == APAIR_IK_PARALLEL_APAIR ? apair_ik_closed_init_apair(self->solver, d, amplitude, scale)
-                                              : apair_ik_closed_init(self->solver, family, d, scale)) {
+        if (apairs ? apair_ik_closed_init_apair(self->solver, d, (const double *)PyArray_DATA(amp), scale) ||
+                         self->solver->family != family
+                   : apair_ik_closed_init(self->solver, family, d, scale)) {
             PyMem_Free(self->solver);
             self->solver = NULL;
         }
     }
     Py_DECREF(dh);
+    Py_XDECREF(amp);
     if (self->solver == NULL) {
         PyErr_SetString(PyExc_ValueError, "ClosedIK: dh (6, 4) of a chain this closed form solves, scale > 0 and reach >= 0");
         return -1;
@@ -74,7 +91,7 @@ static int closed_init(ClosedIKObject *self, PyObject *args, PyObject *kwds)
 
 static PyObject *closed_call(ClosedIKObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
-    double T[16], tol, q[6 * APAIR_IK_PARALLEL_APAIR_MAX], error[APAIR_IK_PARALLEL_APAIR_MAX];
+    double T[16], tol, q[6 * APAIR_IK_APAIR_MAX], error[APAIR_IK_APAIR_MAX];
     int found = 0, candidates = 0, flags = 0, rc;
     npy_intp dims[2];
     PyObject *qa, *ea;
@@ -126,9 +143,10 @@ PyTypeObject apair_native_closed_ik_type = {
     .tp_basicsize = sizeof(ClosedIKObject),
     .tp_dealloc = (destructor)closed_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "ClosedIK(family, dh, scale, reach, amplitude=0): the single-pose fast path of AChain.ik for chains "
+    .tp_doc = "ClosedIK(family, dh, scale, reach, amplitude=None): the single-pose fast path of AChain.ik for chains "
               "solved in closed form (1: a spherical wrist, 2: axes 2, 3, 4 parallel, 3: axes 1, 2, 3 parallel with 5, 6 "
-              "meeting, | 4 at the base end; 8: a UR-like chain with an A-pair of that amplitude at joint 3; "
+              "meeting, | 4 at the base end; 8 and 16: a UR-like chain with sinusoidal A-pairs of amplitudes amplitude "
+              "(6,) at joint 3, or at joints 1 and 5; 32 and 64: a spherical wrist's with one at joint 3, or at joint 1; "
               "apair.ik.solver).",
     .tp_methods = closed_methods,
     .tp_init = (initproc)closed_init,

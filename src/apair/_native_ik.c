@@ -157,8 +157,14 @@ static int run_three_parallel(const ik_call *c)
 
 static int run_parallel_apair(const ik_call *c)
 {
-    return apair_ik_parallel_apair(in(c, 0), c->s[1].d, c->s[2].d, c->rows, in(c, 3), 16, c->s[4].d, out(c, 0),
+    return apair_ik_parallel_apair(in(c, 0), in(c, 1), c->s[2].d, c->rows, in(c, 3), 16, c->s[4].d, out(c, 0),
                                    out(c, 1), out(c, 2), out(c, 3), out(c, 4));
+}
+
+static int run_wrist_apair(const ik_call *c)
+{
+    return apair_ik_wrist_apair(in(c, 0), in(c, 1), c->s[2].d, c->rows, in(c, 3), 16, c->s[4].d, out(c, 0), out(c, 1),
+                                out(c, 2), out(c, 3), out(c, 4));
 }
 
 static int prepare_pencil(ik_call *c)
@@ -210,7 +216,7 @@ static int run_left(const ik_call *c)
 /* ---- the table */
 
 enum { IK_TRACK, IK_TRACK_SLICE, IK6R_ANGLES, IK_NEWTON, IK_LOCAL, IK4_PENCIL, IK4_SCREEN, IK4_LEFT, IK_WRIST, IK_PARALLEL, IK_THREE_PARALLEL,
-       IK_PARALLEL_APAIR };
+       IK_PARALLEL_APAIR, IK_WRIST_APAIR };
 
 static const ik_entry ik_entries[] = {
     [IK_TRACK] = {
@@ -305,12 +311,22 @@ static const ik_entry ik_entries[] = {
         .error = "ik_three_parallel: axes 1, 2, 3 not parallel, axes 5 and 6 not meeting, or a scale <= 0",
     },
     [IK_PARALLEL_APAIR] = {
-        .format = "OddOd", /* dh, amplitude, scale, target, tol */
-        .arrays = {{"dh", F64, 2, {6, 4}}, {"target", F64, 3, {ANY, 4, 4}}},
-        .out = {{"q", F64, 3, {ROWS, 24, 6}}, {"error", F64, 2, {ROWS, 24}}, {"found", I32, 1, {ROWS}},
+        .format = "OOdOd", /* dh, amplitude, scale, target, tol */
+        .arrays = {{"dh", F64, 2, {6, 4}}, {"amplitude", F64, 1, {6}}, {"target", F64, 3, {ANY, 4, 4}}},
+        .out = {{"q", F64, 3, {ROWS, 32, 6}}, {"error", F64, 2, {ROWS, 32}}, {"found", I32, 1, {ROWS}},
                 {"candidates", I32, 1, {ROWS}}, {"flags", I32, 1, {ROWS}}},
         .rows = 3, .nogil = 1, .run = run_parallel_apair,
-        .error = "ik_parallel_apair: not a UR-like design with its A-pair at joint 3, an amplitude <= 0, or a scale <= 0",
+        .error = "ik_parallel_apair: not a UR-like design with A-pairs at joint 3 or at joints 1 and 5, an amplitude < 0, "
+                 "or a scale <= 0",
+    },
+    [IK_WRIST_APAIR] = {
+        .format = "OOdOd", /* dh, amplitude, scale, target, tol */
+        .arrays = {{"dh", F64, 2, {6, 4}}, {"amplitude", F64, 1, {6}}, {"target", F64, 3, {ANY, 4, 4}}},
+        .out = {{"q", F64, 3, {ROWS, 32, 6}}, {"error", F64, 2, {ROWS, 32}}, {"found", I32, 1, {ROWS}},
+                {"candidates", I32, 1, {ROWS}}, {"flags", I32, 1, {ROWS}}},
+        .rows = 3, .nogil = 1, .run = run_wrist_apair,
+        .error = "ik_wrist_apair: not a spherical-wrist design with axes 2 and 3 parallel and an A-pair at joint 3 "
+                 "or 1, an amplitude <= 0, or a scale <= 0",
     },
 };
 
@@ -435,6 +451,7 @@ static PyObject *ik_wrist(PyObject *m, PyObject *args) { return ik_marshal(m, IK
 static PyObject *ik_parallel(PyObject *m, PyObject *args) { return ik_marshal(m, IK_PARALLEL, args); }
 static PyObject *ik_three_parallel(PyObject *m, PyObject *args) { return ik_marshal(m, IK_THREE_PARALLEL, args); }
 static PyObject *ik_parallel_apair(PyObject *m, PyObject *args) { return ik_marshal(m, IK_PARALLEL_APAIR, args); }
+static PyObject *ik_wrist_apair(PyObject *m, PyObject *args) { return ik_marshal(m, IK_WRIST_APAIR, args); }
 
 /* ---- LocalIK: the single-pose fast path of AChain.ik_local
  *
@@ -700,7 +717,10 @@ PyMethodDef apair_native_ik_methods[] = {
     {"ik_three_parallel", ik_three_parallel, METH_VARARGS,
      "ik_three_parallel(dh, scale, target, tol) -> (q, error, found, candidates, flags): apair_ik_three_parallel."},
     {"ik_parallel_apair", ik_parallel_apair, METH_VARARGS,
-     "ik_parallel_apair(dh, amplitude, scale, target, tol) -> (q, error, found, candidates, flags): "
+     "ik_parallel_apair(dh, amplitude (6,), scale, target, tol) -> (q, error, found, candidates, flags): "
      "apair_ik_parallel_apair."},
+    {"ik_wrist_apair", ik_wrist_apair, METH_VARARGS,
+     "ik_wrist_apair(dh, amplitude (6,), scale, target, tol) -> (q, error, found, candidates, flags): "
+     "apair_ik_wrist_apair."},
     {NULL, NULL, 0, NULL},
 };

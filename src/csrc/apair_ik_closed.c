@@ -2,8 +2,8 @@
  * The closed-form solvers of six-joint chains behind one prepared solver (apair.h: apair_ik_closed,
  * apair_ik_closed_init, apair_ik_closed_solve): a controller reads the design once into storage it
  * owns, then solves pose after pose; nothing is allocated. The families' own steps are in
- * apair_ik_wrist.c, apair_ik_parallel.c (with the UR arm with an A-pair at joint 3:
- * apair_ik_closed_init_apair, 24 rows a pose) and apair_ik_three_parallel.c. A family at the base
+ * apair_ik_wrist.c, apair_ik_parallel.c (with the arms with A-pairs: a UR arm's at joint 3 or at
+ * joints 1 and 5, a spherical wrist's at joint 3 or 1; apair_ik_closed_init_apair, 32 rows a pose) and apair_ik_three_parallel.c. A family at the base
  * end (APAIR_IK_REVERSED) is the reversed chain's (apair.ik.reverse): in standard DH, T^-1 =
  * Tx(-a_6) Rx(-alpha_6) times six DH joints run from the tool, joint k of them with psi' =
  * -psi_{7-k}, c' = -c_{7-k}, a' = -a_{6-k}, alpha' = -alpha_{6-k} (a'_6 = alpha'_6 = 0).
@@ -42,15 +42,33 @@ int apair_ik_closed_init(apair_ik_closed *solver, int family, const double *dh, 
     return rc;
 }
 
-int apair_ik_closed_init_apair(apair_ik_closed *solver, const double *dh, double amplitude, double scale)
+int apair_ik_closed_init_apair(apair_ik_closed *solver, const double *dh, const double *amplitude, double scale)
 {
-    if (!solver) return -1;
+    if (!solver || !amplitude) return -1;
     solver->family = 0;
     solver->scale = scale;
     memcpy(solver->dh, dh, sizeof solver->dh);
-    if (apair_ik_parallel_apair_prepare(solver->design.d, dh, amplitude, scale)) return -1;
-    solver->family = APAIR_IK_PARALLEL_APAIR;
-    return 0;
+    int at3 = amplitude[2] != 0.0, elsewhere = 0;
+    for (int i = 0; i < 6; i++) elsewhere |= i != 2 && amplitude[i] != 0.0;
+    int family = at3 && !elsewhere ? APAIR_IK_PARALLEL_APAIR : !at3 && elsewhere ? APAIR_IK_PARALLEL_SLIDES : 0;
+    int rc = -1;
+    if (family == APAIR_IK_PARALLEL_APAIR) { /* a UR arm's, else a spherical wrist's with axes 2 and 3 parallel */
+        rc = apair_ik_parallel_apair_prepare(solver->design.d, dh, amplitude[2], scale);
+        if (rc) {
+            family = APAIR_IK_WRIST_APAIR;
+            rc = apair_ik_wrist_apair_prepare(solver->design.d, dh, amplitude[2], scale);
+        }
+    } else if (family == APAIR_IK_PARALLEL_SLIDES) { /* a UR arm's, else a spherical wrist's with one at joint 1 */
+        rc = apair_ik_parallel_slides_prepare(solver->design.d, dh, amplitude, scale);
+        int joint1 = amplitude[0] != 0.0;
+        for (int i = 1; i < 6; i++) joint1 &= amplitude[i] == 0.0;
+        if (rc && joint1) {
+            family = APAIR_IK_WRIST_SLIDES;
+            rc = apair_ik_wrist_slide1_prepare(solver->design.d, dh, amplitude[0], scale);
+        }
+    }
+    if (rc == 0) solver->family = family;
+    return rc;
 }
 
 /* the family's own solver at one pose T (4 x 4) */
@@ -60,6 +78,12 @@ static void solve_form(const apair_ik_closed *solver, const double *T, double to
     int form = form_of(solver->family);
     if (form == APAIR_IK_PARALLEL_APAIR)
         apair_ik_parallel_apair_solve1(solver->design.d, T, tol, q, error, found, candidates, flags);
+    else if (form == APAIR_IK_PARALLEL_SLIDES)
+        apair_ik_parallel_slides_solve1(solver->design.d, T, tol, q, error, found, candidates, flags);
+    else if (form == APAIR_IK_WRIST_APAIR)
+        apair_ik_wrist_apair_solve1(solver->design.d, T, tol, q, error, found, candidates, flags);
+    else if (form == APAIR_IK_WRIST_SLIDES)
+        apair_ik_wrist_slide1_solve1(solver->design.d, T, tol, q, error, found, candidates, flags);
     else if (form == APAIR_IK_WRIST)
         apair_ik_wrist_solve1(solver->design.d, T, tol, q, error, found, candidates, flags);
     else if (form == APAIR_IK_PARALLEL)
@@ -115,11 +139,20 @@ static void solve_reversed(const apair_ik_closed *solver, const double *T, doubl
     closed_sort(q, error, *found);
 }
 
+int apair_ik_closed_rows(const apair_ik_closed *solver)
+{
+    return !solver || !solver->family ? 0
+           : solver->family == APAIR_IK_PARALLEL_APAIR || solver->family == APAIR_IK_PARALLEL_SLIDES ||
+                   solver->family == APAIR_IK_WRIST_APAIR || solver->family == APAIR_IK_WRIST_SLIDES
+               ? CLOSED_APAIR_MAX
+               : CLOSED_MAX;
+}
+
 int apair_ik_closed_solve(const apair_ik_closed *solver, size_t count, const double *target, ptrdiff_t target_stride,
                           double tol, double *q, double *error, int *found, int *candidates, int *flags)
 {
     if (!solver || !solver->family) return -1;
-    size_t rows = solver->family == APAIR_IK_PARALLEL_APAIR ? CLOSED_APAIR_MAX : CLOSED_MAX; /* per pose */
+    size_t rows = (size_t)apair_ik_closed_rows(solver); /* per pose */
     for (size_t j = 0; j < count; j++) {
         const double *T = target + (ptrdiff_t)j * target_stride;
         double *qj = q + 6 * rows * j, *ej = error + rows * j;

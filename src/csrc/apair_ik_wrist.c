@@ -5,8 +5,8 @@
  * (isolated between the real roots of its derivatives, then bisected) give psi_3, the shoulder's
  * psi_1, psi_2 and the wrist's psi_4, psi_5, psi_6 follow in closed form, and each candidate gets up
  * to two Gauss-Newton steps on fk6 and jacobian6 and is kept where fk reproduces the pose to tol
- * (apair_ik_closed.h, shared with apair_ik_parallel.c).
- * Hand-written C: the C backend of codegen copies it into generated/c, the library it belongs to.
+ * (apair_ik_closed.h, shared with apair_ik_parallel.c). The same wrist steps serve an arm with axes
+ * 2 and 3 parallel and a sinusoidal A-pair at joint 3 or at joint 1 (below, after the R-arm's). Hand-written C: the C backend of codegen copies it into generated/c, the library it belongs to.
  * Declared in apair.h (template: codegen/backends/c/templates/apair.h.j2).
  */
 #include "apair_ik_closed.h"
@@ -196,5 +196,212 @@ int apair_ik_wrist(const double *dh, double scale, size_t count, const double *t
 {
     apair_ik_closed solver;
     if (apair_ik_closed_init(&solver, APAIR_IK_WRIST, dh, scale)) return -1;
+    return apair_ik_closed_solve(&solver, count, target, target_stride, tol, q, error, found, candidates, flags);
+}
+
+/* ---- A spherical-wrist arm with axes 2 and 3 parallel and a sinusoidal A-pair at joint 3
+ * (apair.ik.wrist_apair, where the steps are explained): the derived kernel ik_wrist_apair_position6
+ * (derivations/chain_ik_wrist_apair.py) gives W, L = cos alpha_2 d_3 in (1, cos psi_1, sin psi_1), E_s and,
+ * in t = tan(psi_1/2), kappa cos psi_3 and kappa E_s sin psi_3 and the polynomial of degree 8 whose
+ * real roots give psi_1; psi_3 = atan2 of the two, psi_2 turns the elbow's plane onto W - O_1 in
+ * frame 1, and the wrist's angles follow as on the R-arm above; theta_3 is the angle in (-2 pi, 2 pi]
+ * whose slide h cos(theta_3/2) has the sign of cos alpha_2 L, with its twin where it is near +-pi. */
+
+typedef struct {
+    wrist_design w; /* the R-arm's wrist steps; its inv_pos holds ik_wrist_apair_position6's invariants */
+    double law[2];
+} wrist_apair_design;
+
+/* the prepared design lives in apair_ik_closed's storage */
+typedef char wrist_apair_design_fits[sizeof(wrist_apair_design) <= sizeof(((apair_ik_closed *)0)->design) ? 1 : -1];
+
+/* p(psi_3): the wrist point in frame 1 before the turn psi_2 */
+static void elbow_point(const wrist_design *w, double psi3, double *p)
+{
+    double c3 = cos(psi3), s3 = sin(psi3), m[3] = {c3 * w->m3[0] - s3 * w->m3[1], s3 * w->m3[0] + c3 * w->m3[1], w->m3[2]};
+    for (int r = 0; r < 3; r++) p[r] = w->B2[4 * r] * m[0] + w->B2[4 * r + 1] * m[1] + w->B2[4 * r + 2] * m[2] + w->B2[4 * r + 3];
+}
+
+/* R_6 Rx(alpha_6)^T (3 x 3) from the pose T */
+static void tool_rotation(const wrist_design *w, const double *Tt, double *R6x)
+{
+    for (int r = 0; r < 3; r++) {
+        R6x[3 * r] = Tt[4 * r];
+        R6x[3 * r + 1] = Tt[4 * r + 1] * w->ca6 - Tt[4 * r + 2] * w->sa6;
+        R6x[3 * r + 2] = Tt[4 * r + 1] * w->sa6 + Tt[4 * r + 2] * w->ca6;
+    }
+}
+
+/* The candidates of an arm with an A-pair at joint at + 1 (0 or 2) at psi_1, psi_2, psi_3 (A1: joint 1's
+ * transform at psi_1, with its slide), the pair's angle theta: the wrist's angles from M = R_3^T R6x, then each
+ * candidate (and, where `twin`, its twin -theta where theta is near +-pi: the slide 0) polished, made
+ * canonical and kept */
+static void apair_wrist_keep(const wrist_design *w, const double *Tt, double tol, const double *R6x, const double *A1,
+                             double psi1, double psi2, double psi3, int at, double theta, int twin, double *qj,
+                             double *ej, int *found, int *candidates, int *flags)
+{
+    const double *dh = w->dh, *amp = w->k.amp;
+    double A2[12], A3[12], A[12], M[9], psi456[6];
+    closed_dh4(dh[4], w->ca[1], w->sa[1], dh[6], psi2, A2);
+    closed_dh4(dh[8], w->ca[2], w->sa[2], dh[10], psi3, A3);
+    closed_mul34(A1, A2, A);
+    closed_mul34(A, A3, A);
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) M[3 * r + k] = A[r] * R6x[k] + A[4 + r] * R6x[3 + k] + A[8 + r] * R6x[6 + k];
+    int n456 = wrist(w, M, psi456, flags), twins = twin && fabs(fabs(theta) - CLOSED_PI) <= 1e-4 ? 2 : 1;
+    for (int k456 = 0; k456 < n456; k456++)
+        for (int tw = 0; tw < twins; tw++) {
+            double x[6] = {psi1, psi2, psi3, psi456[3 * k456], psi456[3 * k456 + 1], psi456[3 * k456 + 2]};
+            for (int i = 0; i < 6; i++) x[i] = closed_wrap(x[i] - w->phi[i]);
+            x[at] = tw ? -theta : theta;
+            (*candidates)++;
+            double err = closed_polish(&w->k, dh, w->scale, Tt, tol, x);
+            if (!(err <= tol)) continue;
+            err = canonical_wrist(w, dh, w->scale, Tt, tol, x, err, flags);
+            for (int i = 0; i < 6; i++) x[i] = amp[i] != 0.0 ? closed_wrap4(x[i]) : closed_wrap(x[i]);
+            closed_apair_keep(amp, qj, ej, found, x, err);
+        }
+}
+
+int apair_ik_wrist_apair_prepare(void *design, const double *dh, double amplitude, double scale)
+{
+    wrist_apair_design *d = (wrist_apair_design *)design;
+    wrist_design *w = &d->w;
+    if (apair_ik_wrist_prepare(w, dh, scale) || !(amplitude > 0 && isfinite(amplitude)) ||
+        APAIR_IK_WRIST_APAIR_POSITION6_INVARIANTS > CLOSED_INV_MAX)
+        return -1;
+    /* a spherical wrist (a_4 = a_5 = c_5 = 0), axes 2 and 3 parallel, sin phi_3 = 0, 2 a_2 sin alpha_3 c_4 != 0 */
+    if (fabs(dh[12]) > CLOSED_FLAT * scale || fabs(dh[16]) > CLOSED_FLAT * scale || fabs(dh[18]) > CLOSED_FLAT * scale ||
+        fabs(w->sa[1]) > CLOSED_FLAT || fabs(sin(dh[11])) > CLOSED_FLAT ||
+        fabs(2 * dh[4] * w->sa[2] * dh[14]) <= CLOSED_FLAT * scale * scale)
+        return -1;
+    w->k.amp[2] = amplitude;
+    d->law[0] = d->law[1] = 0.5 * amplitude * amplitude; /* d_3^2 = h^2 cos^2(theta_3/2) = kappa_0 + kappa_1 cos theta_3 */
+    apair_ik_wrist_apair_position6_invariants(dh, d->law, w->inv_pos);
+    return 0;
+}
+
+void apair_ik_wrist_apair_solve1(const void *design, const double *Tt, double tol, double *qj, double *ej, int *found,
+                                 int *candidates, int *flags)
+{
+    const wrist_apair_design *d = (const wrist_apair_design *)design;
+    const wrist_design *w = &d->w;
+    const double *dh = w->dh;
+    double W[3], L[3], Es, cs[10], poly[9];
+    *found = *candidates = *flags = 0;
+    apair_ik_wrist_apair_position6_core(w->inv_pos, dh, Tt, d->law, W, L, &Es, cs, poly);
+    double big = w->scale + sqrt(W[0] * W[0] + W[1] * W[1] + W[2] * W[2]), size = fabs(Es) * (big * big + d->law[1]);
+    double psi1s[CLOSED_ROOTS + 1];
+    int n1 = closed_half_angles(8, poly, size * size, psi1s);
+    if (n1 < 0) { *flags = -1; return; } /* the polynomial vanishes: not separated */
+    double R6x[9], tiny = (CLOSED_FLAT * w->scale) * (CLOSED_FLAT * w->scale);
+    tool_rotation(w, Tt, R6x);
+    for (int k1 = 0; k1 < n1; k1++) {
+        double psi1 = psi1s[k1], cv, sv;
+        if (k1 == n1 - 1 && psi1 == CLOSED_PI) { cv = cs[4]; sv = cs[9]; } /* t = infinity: the leading coefficients */
+        else { double t = tan(0.5 * psi1); cv = closed_horner(4, cs, t); sv = closed_horner(4, cs + 5, t); }
+        double psi3 = atan2(sv / Es, cv); /* kappa cos psi_3, kappa sin psi_3 */
+        double A1[12], u[3], p[3];
+        closed_dh4(dh[0], w->ca[0], w->sa[0], dh[2], psi1, A1);
+        for (int k = 0; k < 3; k++) /* W - O_1 in frame 1 */
+            u[k] = A1[k] * (W[0] - A1[3]) + A1[4 + k] * (W[1] - A1[7]) + A1[8 + k] * (W[2] - A1[11]);
+        elbow_point(w, psi3, p);
+        double psi2 = 0.0;
+        if (p[0] * p[0] + p[1] * p[1] <= tiny) *flags |= 4; /* the wrist point on axis 2: psi_2 free */
+        else psi2 = atan2(p[0] * u[1] - p[1] * u[0], p[0] * u[0] + p[1] * u[1]);
+        /* theta_3: the representative whose slide has the sign of d_3 = cos alpha_2 L */
+        double d3 = w->ca[1] * (L[0] + L[1] * cos(psi1) + L[2] * sin(psi1)), theta3 = closed_wrap(psi3 - w->phi[2]);
+        if (cos(0.5 * theta3) * d3 < 0) theta3 -= copysign(2 * CLOSED_PI, theta3);
+        apair_wrist_keep(w, Tt, tol, R6x, A1, psi1, psi2, psi3, 2, theta3, 1, qj, ej, found, candidates, flags);
+    }
+    closed_sort(qj, ej, *found);
+}
+
+/* ---- A spherical-wrist arm with axes 2 and 3 parallel and a sinusoidal A-pair at joint 1 (cos alpha_1 = 0;
+ * apair.ik.wrist_slide1, where the steps are explained): the derived kernel ik_wrist_slide1_position6
+ * gives W and the quadratic in t = tan(psi_1/2) whose real roots give psi_1; each has two representatives
+ * theta_1 in (-2 pi, 2 pi] (slides of opposite signs), and for each the elbow's two psi_3 from
+ * rho^2 = E_0 + E_c cos psi_3 + E_s sin psi_3, then psi_2 and the wrist as above: at most 16 solutions. */
+
+typedef struct {
+    wrist_design w; /* the R-arm's wrist steps; its inv_pos holds ik_wrist_slide1_position6's invariants */
+    double E0, Ec, Es, h;
+} wrist_slide1_design;
+
+typedef char wrist_slide1_design_fits[sizeof(wrist_slide1_design) <= sizeof(((apair_ik_closed *)0)->design) ? 1 : -1];
+
+int apair_ik_wrist_slide1_prepare(void *design, const double *dh, double amplitude, double scale)
+{
+    wrist_slide1_design *d = (wrist_slide1_design *)design;
+    wrist_design *w = &d->w;
+    if (apair_ik_wrist_prepare(w, dh, scale) || !(amplitude > 0 && isfinite(amplitude)) ||
+        APAIR_IK_WRIST_SLIDE1_POSITION6_INVARIANTS > CLOSED_INV_MAX)
+        return -1;
+    /* a spherical wrist (a_4 = a_5 = c_5 = 0), axes 2 and 3 parallel, axis 1 at right angles to axis 2 */
+    if (fabs(dh[12]) > CLOSED_FLAT * scale || fabs(dh[16]) > CLOSED_FLAT * scale || fabs(dh[18]) > CLOSED_FLAT * scale ||
+        fabs(w->sa[1]) > CLOSED_FLAT || fabs(w->ca[0]) > CLOSED_FLAT)
+        return -1;
+    double r[3], p[3]; /* |p_xy|^2 at psi_3 = 0, pi/2, pi */
+    for (int k = 0; k < 3; k++) {
+        elbow_point(w, k * CLOSED_PI / 2, p);
+        r[k] = p[0] * p[0] + p[1] * p[1];
+    }
+    d->E0 = 0.5 * (r[0] + r[2]);
+    d->Ec = 0.5 * (r[0] - r[2]);
+    d->Es = r[1] - d->E0;
+    if (!(hypot(d->Ec, d->Es) > CLOSED_FLAT * scale * scale)) return -1; /* the elbow is not read from rho^2 */
+    w->k.amp[0] = d->h = amplitude;
+    apair_ik_wrist_slide1_position6_invariants(dh, w->inv_pos);
+    return 0;
+}
+
+void apair_ik_wrist_slide1_solve1(const void *design, const double *Tt, double tol, double *qj, double *ej, int *found,
+                                  int *candidates, int *flags)
+{
+    const wrist_slide1_design *d = (const wrist_slide1_design *)design;
+    const wrist_design *w = &d->w;
+    const double *dh = w->dh;
+    double W[3], L[3], quad[3];
+    *found = *candidates = *flags = 0;
+    apair_ik_wrist_slide1_position6_core(w->inv_pos, dh, Tt, W, L, quad);
+    double psi1s[CLOSED_ROOTS + 1];
+    int n1 = closed_half_angles(2, quad, w->scale + sqrt(W[0] * W[0] + W[1] * W[1] + W[2] * W[2]), psi1s);
+    if (n1 < 0) { *flags = -1; return; } /* the polynomial vanishes: not separated */
+    double R6x[9], tiny = (CLOSED_FLAT * w->scale) * (CLOSED_FLAT * w->scale), K = hypot(d->Ec, d->Es);
+    double beta = atan2(d->Es, d->Ec);
+    tool_rotation(w, Tt, R6x);
+    for (int k1 = 0; k1 < n1; k1++) {
+        double psi1 = psi1s[k1], t1 = closed_wrap(psi1 - w->phi[0]);
+        double theta1[2] = {t1, closed_wrap4(t1 - copysign(2 * CLOSED_PI, t1))};
+        for (int j1 = 0; j1 < 2; j1++) {
+            double A1[12], u[3];
+            closed_dh4(dh[0], w->ca[0], w->sa[0], dh[2] + d->h * cos(0.5 * theta1[j1]), psi1, A1);
+            for (int k = 0; k < 3; k++) /* W - O_1 in frame 1 */
+                u[k] = A1[k] * (W[0] - A1[3]) + A1[4 + k] * (W[1] - A1[7]) + A1[8 + k] * (W[2] - A1[11]);
+            double x = (u[0] * u[0] + u[1] * u[1] - d->E0) / K; /* cos(psi_3 - beta) */
+            if (!(fabs(x) <= 1 + 1e-6)) continue;
+            double rest = 1 - x * x, turn = rest <= 4 * CLOSED_DOUBLE ? 0.0 : acos(fmin(1.0, fmax(-1.0, x)));
+            for (int e = 0; e < (turn > 0 ? 2 : 1); e++) {
+                double psi3 = e ? beta - turn : beta + turn, p[3], psi2 = 0.0;
+                elbow_point(w, psi3, p);
+                if (p[0] * p[0] + p[1] * p[1] <= tiny) *flags |= 4; /* the wrist point on axis 2: psi_2 free */
+                else psi2 = atan2(p[0] * u[1] - p[1] * u[0], p[0] * u[0] + p[1] * u[1]);
+                /* (theta_1's twins are its two representatives already) */
+                apair_wrist_keep(w, Tt, tol, R6x, A1, psi1, psi2, psi3, 0, theta1[j1], 0, qj, ej, found, candidates,
+                                 flags);
+            }
+        }
+    }
+    closed_sort(qj, ej, *found);
+}
+
+int apair_ik_wrist_apair(const double *dh, const double *amplitude, double scale, size_t count, const double *target,
+                         ptrdiff_t target_stride, double tol, double *q, double *error, int *found, int *candidates,
+                         int *flags)
+{
+    apair_ik_closed solver;
+    if (apair_ik_closed_init_apair(&solver, dh, amplitude, scale) ||
+        (solver.family != APAIR_IK_WRIST_APAIR && solver.family != APAIR_IK_WRIST_SLIDES))
+        return -1;
     return apair_ik_closed_solve(&solver, count, target, target_stride, tol, q, error, found, candidates, flags);
 }

@@ -1,6 +1,7 @@
 """The single-pose fast path of `ik` for the chains solved in closed form (apair._native.ClosedIK,
 set up with the chain's solver): the same numbers as the validating path on spherical-wrist, UR
-and 1∥2∥3 arms and UR designs with an A-pair at joint 3, reachable and unreachable poses; whatever
+and 1∥2∥3 arms, UR designs with A-pairs at joint 3 or at joints 1 and 5 and spherical-wrist arms
+with an A-pair at joint 3 or 1, reachable and unreachable poses; whatever
 it declines (other dtypes, NaN, a pose that is not rigid, a bad tol, full=True, frames) goes to the
 validating path, which answers or raises as before; the NumPy backend keeps its twin; a chain
 pickles after ik."""
@@ -13,8 +14,11 @@ import numpy as np
 import pytest
 import test_ik_parallel as parallel_arms
 import test_ik_parallel_apair as apair_arms
+import test_ik_parallel_slides as slides_arms
 import test_ik_three_parallel as three_parallel_arms
 import test_ik_wrist as wrist_arms
+import test_ik_wrist_apair as wrist_apair_arms
+import test_ik_wrist_slide1 as wrist_slide1_arms
 
 import apair
 from apair.frames import frame
@@ -29,6 +33,12 @@ def arms():
             yield name, mod.arm(name)
     for name in apair_arms.DESIGNS:  # an A-pair at joint 3 (apair_ik_closed_init_apair)
         yield f"{name} + A-pair at joint 3", apair_arms.chain_of(name)
+    for name in slides_arms.DESIGNS:  # A-pairs at joints 1 and 5 (the same C entry)
+        yield name, slides_arms.chain_of(name)
+    for name in wrist_apair_arms.DESIGNS:  # a spherical wrist's A-pair at joint 3
+        yield f"{name} + A-pair at joint 3", wrist_apair_arms.chain_of(name)
+    for name in wrist_slide1_arms.DESIGNS:  # or at joint 1
+        yield f"{name} + A-pair at joint 1", wrist_slide1_arms.chain_of(name)
 
 
 @pytest.fixture(autouse=True)

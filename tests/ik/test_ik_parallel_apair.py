@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import apair
-from apair.ik.parallel_apair import ParallelAPair
+from apair.ik.parallel_apair import ParallelAPair, one_per_multiple_root
 from apair.ik.poses import refine
 from apair.ik.solver import Solver
 
@@ -205,6 +205,6 @@ def test_numpy_twin_gives_the_same_sets(name):
     for q in random_q(rng, 30):
         T = chain.fk(q)
         cands, _ = form.candidates(T, 1e-9)
-        twin, _ = form._one_per_multiple_root(*refine(chain, cands, T, 1e-9, form.scale))
+        twin, _ = one_per_multiple_root(chain, *refine(chain, cands, T, 1e-9, form.scale))
         ours = chain.ik(T)
         assert len(twin) == len(ours) and all(among(s, ours) for s in twin), (name, q)

@@ -1,15 +1,25 @@
 """Which closed form solves a six-joint chain (issue 42): its family's (apair.ik.wrist,
 apair.ik.parallel, apair.ik.three_parallel; apair.ik.parallel_apair for a UR-like arm with an A-pair
-at joint 3), at the tool end or, for an R-chain's family at the base end, the reversed chain's
-(apair.ik.reverse); None where the chain has none (the general solvers answer)."""
+at joint 3, apair.ik.parallel_slides for one with A-pairs at joints 1 and 5, apair.ik.wrist_apair
+and wrist_slide1 for a spherical-wrist arm with an A-pair at joint 3 or 1), at the tool end or, for
+an R-chain's family at the base end, the reversed chain's (apair.ik.reverse); None where the chain
+has none (the general solvers answer)."""
 
 from __future__ import annotations
 
-from . import parallel, parallel_apair, three_parallel, wrist
+from . import parallel, parallel_apair, parallel_slides, three_parallel, wrist, wrist_apair, wrist_slide1
 from .families import Classification, classify
 from .reverse import Reversed, ReversedView
 
-Forward = wrist.Wrist | parallel.Parallel | three_parallel.ThreeParallel | parallel_apair.ParallelAPair
+Forward = (
+    wrist.Wrist
+    | parallel.Parallel
+    | three_parallel.ThreeParallel
+    | parallel_apair.ParallelAPair
+    | parallel_slides.ParallelSlides
+    | wrist_apair.WristAPair
+    | wrist_slide1.WristSlide1
+)
 Form = Forward | Reversed
 
 
@@ -21,6 +31,9 @@ def forward_form(chain, family: Classification, scale: float) -> Forward | None:
         (parallel, parallel.Parallel),
         (three_parallel, three_parallel.ThreeParallel),
         (parallel_apair, parallel_apair.ParallelAPair),
+        (parallel_slides, parallel_slides.ParallelSlides),
+        (wrist_apair, wrist_apair.WristAPair),
+        (wrist_slide1, wrist_slide1.WristSlide1),
     ):
         if module.applies(chain, family):
             try:

@@ -57,7 +57,7 @@ class Parallel:
     """The closed form of one chain: its design read once."""
 
     code = 2  # the family in apair.h (APAIR_IK_PARALLEL)
-    amplitude = 0.0  # of an A-pair at joint 3 (apair.ik.parallel_apair)
+    amplitude: NDArray[np.float64] | None = None  # the A-pairs' amplitudes (apair.ik.parallel_apair, parallel_slides)
     flags = FLAGS  # the continua its C form flags, by bit
 
     def __init__(self, chain, scale: float) -> None:
@@ -155,26 +155,31 @@ class Parallel:
         vx, vy = eps * v[0], eps * v[1]
         return math.atan2(wy * vx - wx * vy, wx * vx + wy * vy)
 
-    def _free_psi6(self, psi1: float, psi5: float, Tm) -> float:
+    def _free_psi6(self, psi1: float, psi5: float, Tm, dh: NDArray[np.float64] | None = None) -> float:
         """Where ψ_6 is free, frame 3's origin runs on a circle as ψ_6 turns, ρ² = A + B cos ψ_6 +
         C sin ψ_6: the member with the elbow at cos ψ_3 = 0 (ρ² = a_2² + a_3²) where the circle
         reaches it, else the nearest."""
-        A, B, C = self._circle(psi1, psi5, Tm)
+        A, B, C = self._circle(psi1, psi5, Tm, dh)
         K = math.hypot(B, C)
         mid = self.dh[1, 0] ** 2 + self.dh[2, 0] ** 2
         if not K > FLAT * mid:
             return 0.0
         return math.atan2(C, B) + math.acos(max(-1.0, min(1.0, (mid - A) / K)))
 
-    def _circle(self, psi1: float, psi5: float, Tm) -> tuple[float, float, float]:
+    def _circle(
+        self, psi1: float, psi5: float, Tm, dh: NDArray[np.float64] | None = None
+    ) -> tuple[float, float, float]:
         """(A, B, C) of ρ² = A + B cos ψ_6 + C sin ψ_6, frame 3's distance from axis 2 as ψ_6 turns."""
-        r = [float(np.sum(self._frame3(psi1, psi5, k * math.pi / 2, Tm)[1] ** 2)) for k in range(3)]
+        r = [float(np.sum(self._frame3(psi1, psi5, k * math.pi / 2, Tm, dh)[1] ** 2)) for k in range(3)]
         A, B = 0.5 * (r[0] + r[2]), 0.5 * (r[0] - r[2])
         return A, B, r[1] - A
 
-    def _frame3(self, psi1: float, psi5: float, psi6: float, Tm) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """N = A_2 A_3 A_4 and frame 3's origin's (x, y) in frame 1."""
-        d = self.dh
+    def _frame3(
+        self, psi1: float, psi5: float, psi6: float, Tm, dh: NDArray[np.float64] | None = None
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """N = A_2 A_3 A_4 and frame 3's origin's (x, y) in frame 1 (`dh`: the design with the
+        A-pairs' slides added to c_1 and c_5, apair.ik.parallel_slides; default the chain's)."""
+        d = self.dh if dh is None else dh
         A1 = dh_matrix(d[0, 0], d[0, 1], d[0, 2], psi1)
         A5 = dh_matrix(d[4, 0], d[4, 1], d[4, 2], psi5)
         A6 = dh_matrix(d[5, 0], d[5, 1], d[5, 2], psi6)
@@ -182,12 +187,19 @@ class Parallel:
         return N, (N[:3, 3] - N[:3, :3] @ self.o3)[:2]
 
     def _inner(
-        self, psi1: float, psi5: float, psi6: float, Tm, free: set[str], stretched: float = DOUBLE * 4
+        self,
+        psi1: float,
+        psi5: float,
+        psi6: float,
+        Tm,
+        free: set[str],
+        stretched: float = DOUBLE * 4,
+        dh: NDArray[np.float64] | None = None,
     ) -> list[list[float]]:
         """ψ_2, ψ_3, ψ_4 of the planar 3R problem left by ψ_1, ψ_5, ψ_6: [ψ_1 … ψ_6] per elbow (one,
-        the stretched or folded elbow, where sin² ψ_3 ≤ `stretched`)."""
+        the stretched or folded elbow, where sin² ψ_3 ≤ `stretched`; `dh` as _frame3's)."""
         d = self.dh
-        N, O3 = self._frame3(psi1, psi5, psi6, Tm)
+        N, O3 = self._frame3(psi1, psi5, psi6, Tm, dh)
         a2, a3 = d[1, 0], d[2, 0]
         rho2 = O3[0] ** 2 + O3[1] ** 2
         c3 = (rho2 - a2 * a2 - a3 * a3) / (2 * a2 * a3)

@@ -46,7 +46,52 @@ def applies(chain, family: Classification) -> bool:
     )
 
 
-class ParallelAPair(Parallel):
+def one_per_multiple_root(chain, q: NDArray[np.float64], err: NDArray[np.float64]):
+    """At a singular pose (a multiple root, e.g. the slide's top with the elbow stretched and axis
+    6 parallel to axes 2-4) the roots come √eps apart and verify to tol as a cluster around the
+    exact solution: the most accurate one stands for the others within MULTIPLE of it. (Two
+    distinct solutions that close need a near-singular Jacobian between them, where tol cannot
+    tell them apart.) As the C twins' apair_keep."""
+    if len(q) <= 1:
+        return q, err
+    near = np.all(np.abs(wrap(q[:, None] - q[None], joint_periods(chain))) < MULTIPLE, axis=-1)
+    np.fill_diagonal(near, False)
+    if not near.any():
+        return q, err
+    kept: list[int] = []
+    for k in np.argsort(err, kind="stable"):
+        if not any(near[k, j] for j in kept):
+            kept.append(int(k))
+    keep = np.sort(np.array(kept))
+    return q[keep], err[keep]
+
+
+class APairForm(Parallel):
+    """What the closed forms of UR arms with A-pairs share (ParallelAPair, and ParallelSlides in
+    apair.ik.parallel_slides): the amplitudes per joint, and the solve over their C entry."""
+
+    amplitude: NDArray[np.float64]
+
+    def solve(self, Tm: NDArray[np.float64], tol: float) -> tuple[NDArray[np.float64], NDArray[np.float64], int, str]:
+        """Every real solution (k, 6) at frame 6's pose Tm, verified to tol, their errors, the
+        candidates examined and a note naming a continuum: in C (apair_ik_parallel_apair, with the
+        amplitudes) where the C backend is in use, else the same steps here."""
+        native = native_in_use()
+        if native is None:
+            cands, free = self.candidates(Tm, tol)
+            q, err = refine(self.chain, cands, Tm, tol, self.scale)
+            q, err = one_per_multiple_root(self.chain, q, err)
+            return q, err, len(cands), note(free)
+        q, err, found, cands, flags = native.ik_parallel_apair(
+            self.dh, self.amplitude, self.scale, Tm.reshape(1, 4, 4), tol
+        )
+        if flags[0] < 0:
+            raise ValueError("the position polynomial vanishes identically")
+        k = int(found[0])
+        return q[0, :k], err[0, :k], int(cands[0]), note({why for bit, why in FLAGS.items() if flags[0] & bit})
+
+
+class ParallelAPair(APairForm):
     """The closed form of one chain: its design read once. ValueError where the design is not
     covered (a wrist other than UR's, sin φ_3 ≠ 0, a_2 a_3 = 0)."""
 
@@ -61,44 +106,10 @@ class ParallelAPair(Parallel):
             raise ValueError("joint 3's angle offset is not 0 or π")
         if min(abs(a[1]), abs(a[2])) <= FLAT * scale:
             raise ValueError("a_2 a_3 = 0")
-        self.h = self.amplitude = float(chain.pairs[2].amplitude)
+        self.h = float(chain.pairs[2].amplitude)
+        self.amplitude = np.array([0.0, 0.0, self.h, 0.0, 0.0, 0.0])
         self.law = np.array([self.h**2 / 2, self.h**2 / 2])  # d_3² = κ_0 + κ_1 cos θ_3
         self.case = "g" if abs(self.dh[4, 2]) <= FLAT * scale else "poly"  # c_5 = 0: H ≡ 0
-
-    def solve(self, Tm: NDArray[np.float64], tol: float) -> tuple[NDArray[np.float64], NDArray[np.float64], int, str]:
-        """Every real solution (k, 6) at frame 6's pose Tm, verified to tol, their errors, the
-        candidates examined and a note naming a continuum: in C (apair_ik_parallel_apair) where the
-        C backend is in use, else the same steps here."""
-        native = native_in_use()
-        if native is None:
-            cands, free = self.candidates(Tm, tol)
-            q, err = refine(self.chain, cands, Tm, tol, self.scale)
-            q, err = self._one_per_multiple_root(q, err)
-            return q, err, len(cands), note(free)
-        q, err, found, cands, flags = native.ik_parallel_apair(self.dh, self.h, self.scale, Tm.reshape(1, 4, 4), tol)
-        if flags[0] < 0:
-            raise ValueError("the position polynomial vanishes identically")
-        k = int(found[0])
-        return q[0, :k], err[0, :k], int(cands[0]), note({FLAGS[1]} if flags[0] & 1 else set())
-
-    def _one_per_multiple_root(self, q: NDArray[np.float64], err: NDArray[np.float64]):
-        """At a singular pose (a multiple root, e.g. the slide's top with the elbow stretched and axis
-        6 parallel to axes 2-4) the roots come √eps apart and verify to tol as a cluster around the
-        exact solution: the most accurate one stands for the others within MULTIPLE of it. (Two
-        distinct solutions that close need a near-singular Jacobian between them, where tol cannot
-        tell them apart.) As the C twin's apair_keep."""
-        if len(q) <= 1:
-            return q, err
-        near = np.all(np.abs(wrap(q[:, None] - q[None], joint_periods(self.chain))) < MULTIPLE, axis=-1)
-        np.fill_diagonal(near, False)
-        if not near.any():
-            return q, err
-        kept: list[int] = []
-        for k in np.argsort(err, kind="stable"):
-            if not any(near[k, j] for j in kept):
-                kept.append(int(k))
-        keep = np.sort(np.array(kept))
-        return q[keep], err[keep]
 
     def candidates(self, Tm: NDArray[np.float64], tol: float) -> tuple[NDArray[np.float64], set[str]]:
         """Candidate joint vectors (k, 6) at frame 6's pose Tm, and the continua met (FLAGS' texts)."""

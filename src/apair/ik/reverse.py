@@ -93,7 +93,7 @@ class Reversed:
     def __init__(self, chain, scale: float, view: ReversedView, inner) -> None:
         self.chain, self.scale, self.view, self.inner = chain, scale, view, inner
         self.code = inner.code | REVERSED
-        self.amplitude = 0.0  # (every joint an R-pair)
+        self.amplitude = None  # (every joint an R-pair)
         self.flags = inner.flags
         self.dh = np.column_stack([chain.a, chain.alpha, chain.offset, chain.theta_offset]).astype(np.float64)
         native, _ = native_module()

@@ -75,7 +75,7 @@ class ThreeParallel:
     """The closed form of one chain: its design read once."""
 
     code = 3  # the family in apair.h (APAIR_IK_THREE_PARALLEL)
-    amplitude = 0.0  # (every joint an R-pair)
+    amplitude = None  # (every joint an R-pair)
     flags = FLAGS  # the continua its C form flags, by bit
 
     def __init__(self, chain, scale: float) -> None:

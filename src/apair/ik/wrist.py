@@ -30,7 +30,7 @@ from ..frames import dh_matrix
 from ..kernels import call, native_in_use
 from .closed import DOUBLE, FLAT, SINGULAR, note, real_roots
 from .families import Classification
-from .poses import pose_error, refine, wrap
+from .poses import joint_periods, pose_error, refine, wrap
 
 CONTINUUM = 1e-6  # a verified solution this close to axes 4 and 6 in line is one of their continuum
 
@@ -64,7 +64,7 @@ class Wrist:
     """The closed form of one chain: its design read once."""
 
     code = 1  # the family in apair.h (APAIR_IK_WRIST)
-    amplitude = 0.0  # (every joint an R-pair)
+    amplitude: NDArray[np.float64] | None = None  # (every joint an R-pair; apair.ik.wrist_apair: the amplitudes)
     flags = FLAGS  # the continua its C form flags, by bit
 
     def __init__(self, chain, scale: float) -> None:
@@ -109,7 +109,7 @@ class Wrist:
         y = q.copy()
         y[:, 5] = q[:, 5] + s * (q[:, 3] + phi[3])
         y[:, 3] = -phi[3]
-        y = wrap(y, 2 * np.pi)
+        y = wrap(y, joint_periods(self.chain))
         _, e2 = pose_error(self.chain, y, Tm, self.scale)
         take = near & (e2 <= tol)
         if not take.any():
