@@ -355,6 +355,18 @@ def _mp_dh(theta_i, d_i, a, alpha, c, phi):
     )
 
 
+def evaluate_real(kernel: KernelSpec, dh, T, *rest, digits: int) -> list:
+    """A real-valued kernel spec in `digits`-digit arithmetic at mpmath inputs: dh rows, the 4×4 pose
+    T, then the further inputs' flat values in order; its outputs, flat."""
+    values = [[x for row in dh for x in row], [T[k // 4, k % 4] for k in range(16)], *rest]
+    env = {}
+    for arg, vals in zip(kernel.inputs, values):
+        env.update({s: sp.Float(x, digits) for s, x in zip(arg.symbols, vals)})
+    for s, e in kernel.steps:
+        env[s] = sp.Float(sp.N(e.xreplace(env), digits), digits)
+    return [mpmath.mpf(sp.N(e.xreplace(env), digits)) for a in kernel.outputs for e in a.exprs]
+
+
 def _mp_qmul(x, y):
     return [
         x[0] * y[0] - x[1] * y[1] - x[2] * y[2] - x[3] * y[3],

@@ -31,7 +31,7 @@ import random
 import mpmath
 import sympy as sp
 
-from .chain_ik import _mp_dh
+from .chain_ik import _mp_dh, evaluate_real
 from .spec import Arg, KernelSpec
 
 SOURCE = "derivations/chain_ik6r.py"
@@ -188,11 +188,7 @@ def check_equations(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> f
             T = mpmath.eye(4)
             for i in range(6):
                 T = T * _mp_dh(psi[i], 0, dh[i][0], dh[i][1], dh[i][2], 0)  # ψ_i = θ_i + φ_i
-            env = {s: sp.Float(x, digits) for s, x in zip(kernel.inputs[0].symbols, [x for r in dh for x in r])}
-            env.update({s: sp.Float(T[k // 4, k % 4], digits) for k, s in enumerate(kernel.inputs[1].symbols)})
-            for s, e in kernel.steps:
-                env[s] = sp.Float(sp.N(e.xreplace(env), digits), digits)
-            vals = [mpmath.mpf(sp.N(e.xreplace(env), digits)) for a in kernel.outputs for e in a.exprs]
+            vals = evaluate_real(kernel, dh, T, digits=digits)
             Pv, Qv = vals[: ROWS * 27], vals[ROWS * 27 :]
             cs = lambda i: [1, mpmath.cos(psi[i]), mpmath.sin(psi[i])]
             X45 = [x * y for x in cs(3) for y in cs(4)]

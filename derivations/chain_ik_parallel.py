@@ -33,7 +33,7 @@ import random
 import mpmath
 import sympy as sp
 
-from .chain_ik import _mp_dh
+from .chain_ik import _mp_dh, evaluate_real
 from .spec import Arg, KernelSpec
 
 SOURCE = "derivations/chain_ik_parallel.py"
@@ -156,11 +156,7 @@ def check(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> float:
             T = mpmath.eye(4)
             for i in range(6):
                 T = T * _mp_dh(psi[i], 0, dh[i][0], dh[i][1], dh[i][2] + slide[i], 0)
-            env = {s: sp.Float(x, digits) for s, x in zip(kernel.inputs[0].symbols, [x for row in dh for x in row])}
-            env.update({s: sp.Float(T[k // 4, k % 4], digits) for k, s in enumerate(kernel.inputs[1].symbols)})
-            for s, e in kernel.steps:
-                env[s] = sp.Float(sp.N(e.xreplace(env), digits), digits)
-            out = [mpmath.mpf(sp.N(e.xreplace(env), digits)) for a in kernel.outputs for e in a.exprs]
+            out = evaluate_real(kernel, dh, T, digits=digits)
             L, (P, Q), quartic, qa, qb = out[:6], out[6:8], out[8:13], out[13:16], out[16:19]
             size = 1 + sum(abs(x) for row in dh for x in (row[0], row[2]))
             c1, s1 = mpmath.cos(psi[0]), mpmath.sin(psi[0])

@@ -40,7 +40,7 @@ import random
 import mpmath
 import sympy as sp
 
-from .chain_ik import _mp_dh
+from .chain_ik import _mp_dh, evaluate_real
 from .chain_ik_parallel import _dh, third_row
 from .spec import Arg, KernelSpec
 
@@ -209,13 +209,7 @@ def check(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> float:
             for i in range(6):
                 T = T * _mp_dh(theta[i], slide[i], dh[i][0], dh[i][1], dh[i][2], dh[i][3])
             law = [h**2 / 2, h**2 / 2]
-            values = [x for row in dh for x in row]
-            env = {s: sp.Float(x, digits) for s, x in zip(kernel.inputs[0].symbols, values)}
-            env.update({s: sp.Float(T[k // 4, k % 4], digits) for k, s in enumerate(kernel.inputs[1].symbols)})
-            env.update({s: sp.Float(x, digits) for s, x in zip(kernel.inputs[2].symbols, law)})
-            for s, e in kernel.steps:
-                env[s] = sp.Float(sp.N(e.xreplace(env), digits), digits)
-            out = [mpmath.mpf(sp.N(e.xreplace(env), digits)) for a in kernel.outputs for e in a.exprs]
+            out = evaluate_real(kernel, dh, T, law, digits=digits)
             L, P, g, hh, poly = out[:6], out[6], out[7:12], out[12:17], out[17:30]
             psi1, psi5 = theta[0] + dh[0][3], theta[4] + dh[4][3]
             size = 1 + sum(abs(x) for row in dh for x in (row[0], row[2])) + h

@@ -27,7 +27,7 @@ import random
 import mpmath
 import sympy as sp
 
-from .chain_ik import _mp_dh
+from .chain_ik import _mp_dh, evaluate_real
 from .chain_ik_parallel import _dh
 from .spec import Arg, KernelSpec
 
@@ -126,11 +126,7 @@ def check(kernel: KernelSpec, samples: int = 4, digits: int = 40) -> float:
             A = [_mp_dh(psi[i], 0, dh[i][0], dh[i][1], dh[i][2], 0) for i in range(6)]
             T = A[0] * A[1] * A[2] * A[3] * A[4] * A[5]
             M = A[0] * A[1] * A[2] * A[3]
-            env = {s: sp.Float(x, digits) for s, x in zip(kernel.inputs[0].symbols, [x for row in dh for x in row])}
-            env.update({s: sp.Float(T[k // 4, k % 4], digits) for k, s in enumerate(kernel.inputs[1].symbols)})
-            for s, e in kernel.steps:
-                env[s] = sp.Float(sp.N(e.xreplace(env), digits), digits)
-            out = [mpmath.mpf(sp.N(e.xreplace(env), digits)) for a in kernel.outputs for e in a.exprs]
+            out = evaluate_real(kernel, dh, T, digits=digits)
             W, (fa, fb, fc), U, g = out[:3], out[3:6], out[6:15], out[15:18]
             size = 1 + sum(abs(x) for row in dh for x in (row[0], row[2]))
             c4, s4 = mpmath.cos(psi[3]), mpmath.sin(psi[3])

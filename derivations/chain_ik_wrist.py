@@ -37,7 +37,7 @@ import random
 import mpmath
 import sympy as sp
 
-from .chain_ik import _mp_dh
+from .chain_ik import _mp_dh, evaluate_real
 from .spec import Arg, KernelSpec
 
 SOURCE = "derivations/chain_ik_wrist.py"
@@ -130,11 +130,7 @@ def check(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> float:
             for i in range(6):
                 frames.append(frames[-1] * _mp_dh(psi[i], 0, dh[i][0], dh[i][1], dh[i][2], 0))
             T = frames[6]
-            env = {s: sp.Float(x, digits) for s, x in zip(kernel.inputs[0].symbols, [x for row in dh for x in row])}
-            env.update({s: sp.Float(T[k // 4, k % 4], digits) for k, s in enumerate(kernel.inputs[1].symbols)})
-            for s, e in kernel.steps:
-                env[s] = sp.Float(sp.N(e.xreplace(env), digits), digits)
-            out = [mpmath.mpf(sp.N(e.xreplace(env), digits)) for a in kernel.outputs for e in a.exprs]
+            out = evaluate_real(kernel, dh, T, digits=digits)
             W, quartic, qa, qb = out[:3], out[5:10], out[10:13], out[13:16]
             size = 1 + sum(abs(x) for row in dh for x in (row[0], row[2]))
             worst = max(worst, *(float(abs(W[k] - frames[4][k, 3]) / size) for k in range(3)))

@@ -52,7 +52,7 @@ import random
 import mpmath
 import sympy as sp
 
-from .chain_ik import _mp_dh
+from .chain_ik import _mp_dh, evaluate_real
 from .chain_ik_parallel import _dh
 from .chain_ik_parallel_apair import _product, in_t
 from .spec import Arg, KernelSpec
@@ -186,12 +186,7 @@ def check(kernel: KernelSpec, samples: int = 3, digits: int = 40) -> float:
                 if i == 3:
                     O4 = [T[r, 3] for r in range(3)]
             law = [h**2 / 2, h**2 / 2]
-            env = {s: sp.Float(x, digits) for s, x in zip(kernel.inputs[0].symbols, [x for row in dh for x in row])}
-            env.update({s: sp.Float(T[k // 4, k % 4], digits) for k, s in enumerate(kernel.inputs[1].symbols)})
-            env.update({s: sp.Float(x, digits) for s, x in zip(kernel.inputs[2].symbols, law)})
-            for s, e in kernel.steps:
-                env[s] = sp.Float(sp.N(e.xreplace(env), digits), digits)
-            out = [mpmath.mpf(sp.N(e.xreplace(env), digits)) for a in kernel.outputs for e in a.exprs]
+            out = evaluate_real(kernel, dh, T, law, digits=digits)
             W, L, Es, C, S, poly = out[:3], out[3:6], out[6], out[7:12], out[12:17], out[17:26]
             size = 1 + sum(abs(x) for row in dh for x in (row[0], row[2])) + h
             worst = max(worst, float(max(abs(a - b) for a, b in zip(W, O4)) / size))
@@ -280,11 +275,7 @@ def check_slide1(kernel: KernelSpec, samples: int = 4, digits: int = 40) -> floa
                 T = T * _mp_dh(theta[i], slide[i], dh[i][0], dh[i][1], dh[i][2], dh[i][3])
                 if i == 3:
                     O4 = [T[r, 3] for r in range(3)]
-            env = {s: sp.Float(x, digits) for s, x in zip(kernel.inputs[0].symbols, [x for row in dh for x in row])}
-            env.update({s: sp.Float(T[k // 4, k % 4], digits) for k, s in enumerate(kernel.inputs[1].symbols)})
-            for s, e in kernel.steps:
-                env[s] = sp.Float(sp.N(e.xreplace(env), digits), digits)
-            out = [mpmath.mpf(sp.N(e.xreplace(env), digits)) for a in kernel.outputs for e in a.exprs]
+            out = evaluate_real(kernel, dh, T, digits=digits)
             W, L, quad = out[:3], out[3:6], out[6:9]
             size = 1 + sum(abs(x) for row in dh for x in (row[0], row[2]))
             worst = max(worst, float(max(abs(a - b) for a, b in zip(W, O4)) / size))

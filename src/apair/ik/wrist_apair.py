@@ -35,13 +35,14 @@ from .wrist import FLAGS, Wrist
 KINDS = ["revolute", "revolute", "sinusoidal", "revolute", "revolute", "revolute"]
 
 
-def applies(chain, family: Classification) -> bool:
-    """Whether the closed form may cover the chain: six joints, a sinusoidal A-pair at joint 3 and
-    R-pairs elsewhere, a spherical wrist at joints 4-6 (axes 2 ∥ 3 is checked by WristAPair)."""
+def applies(chain, family: Classification, kinds: list[str] = KINDS) -> bool:
+    """Whether the closed form may cover the chain: six joints of these kinds (a sinusoidal A-pair at
+    joint 3 and R-pairs elsewhere; apair.ik.wrist_slide1 passes its own), a spherical wrist at joints
+    4-6 (axes 2 ∥ 3 is checked by the form)."""
     f = family.family
     return (
         chain.n == 6
-        and [p.kind for p in chain.pairs] == KINDS
+        and [p.kind for p in chain.pairs] == kinds
         and f is not None
         and f.key.startswith("spherical-")
         and not f.reversed

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from ..frames import dh_matrix
 from ..kernels import call
+from . import wrist_apair
 from .closed import DOUBLE, FLAT, real_roots
 from .families import Classification
 from .poses import wrap
@@ -36,14 +37,7 @@ KINDS = ["sinusoidal", "revolute", "revolute", "revolute", "revolute", "revolute
 def applies(chain, family: Classification) -> bool:
     """Whether the closed form may cover the chain: six joints, a sinusoidal A-pair at joint 1 and
     R-pairs elsewhere, a spherical wrist at joints 4-6 (the rest is checked by WristSlide1)."""
-    f = family.family
-    return (
-        chain.n == 6
-        and [p.kind for p in chain.pairs] == KINDS
-        and f is not None
-        and f.key.startswith("spherical-")
-        and not f.reversed
-    )
+    return wrist_apair.applies(chain, family, KINDS)
 
 
 class WristSlide1(WristAPairForm):
