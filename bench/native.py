@@ -206,7 +206,8 @@ static void rigid(const double *A, const double *B, double *C) /* C = A B, rigid
 
 
 def apair_program(chain, derivatives: bool = True) -> str:
-    """C source timing the generated kernels for `chain` (its pairs' law kernels are fixed here,
+    """C source timing the generated kernels for `chain`, those its methods call (a chain of
+    R-pairs: the REVOLUTE families' forms for it; its pairs' law kernels are fixed here,
     the design is read at run time; the base and tool frames, if any, are applied to fk and the
     Jacobian as frames_code writes them). With `derivatives`, also DERIVATIVES' kernels, each timed
     with the law kernels and the law_<kind>_d3 kernels it needs."""
@@ -235,7 +236,7 @@ def apair_program(chain, derivatives: bool = True) -> str:
             (
                 op,
                 "laws_all();",
-                f"apair_{stem}{n}_batch((size_t)COUNT, {', '.join(call_inputs + design)}, OUT_{op});",
+                f"apair_{chain._kernel(stem)}_batch((size_t)COUNT, {', '.join(call_inputs + design)}, OUT_{op});",
                 [(op, size(n))],
             )
         )
@@ -243,7 +244,9 @@ def apair_program(chain, derivatives: bool = True) -> str:
     for op, (extra, outputs) in DERIVATIVES.items() if derivatives else ():
         state = ", ".join(f"{x.upper()}, {n}" for x in extra)
         results = ", ".join(f"OUT_{name}" for name in outputs)
-        call = f"apair_{op}{n}_batch((size_t)COUNT, LAW, {5 * n}, D3, {n}, {state}, {design_all}, {results});"
+        call = (
+            f"apair_{chain._kernel(op)}_batch((size_t)COUNT, LAW, {5 * n}, D3, {n}, {state}, {design_all}, {results});"
+        )
         ops_code.append((op, "laws_all(); d3_all();", call, [(name, n * n) for name in outputs]))
     body = []
     for op, pre, call, _outs in ops_code:
@@ -477,9 +480,9 @@ def apair_build(chain, workdir: Path, opt: str, derivatives: bool = True) -> Pat
     c_dir = ROOT / "generated" / "c"
     n = chain.n
     kinds = sorted({p.law_kernel[0] for p in chain.pairs})
-    kernels = [f"{stem}{n}" for stem, _, _ in OPERATIONS.values()] + kinds
+    kernels = [chain._kernel(stem) for stem, _, _ in OPERATIONS.values()] + kinds
     if derivatives:
-        kernels += [f"{op}{n}" for op in DERIVATIVES] + [f"{k}_d3" for k in kinds]
+        kernels += [chain._kernel(op) for op in DERIVATIVES] + [f"{k}_d3" for k in kinds]
     exe = workdir / f"apair{n}_{'_'.join(k[4:] for k in kinds)}{'_d' if derivatives else ''}{opt}"
     objects = [str(kernel_object(c_dir / f"{k}.c", opt)) for k in kernels]
     compile_c(apair_program(chain, derivatives), exe, [opt, f"-I{c_dir}", f"-I{PEERS}"], objects + ["-lm"])

@@ -34,7 +34,7 @@ import sympy as sp
 
 from . import apair_pair
 from .autodiff import directional, gradient
-from .chain_kinematics import MAX_N, _Recorder, chain_inputs, joint_trig, turning_arg
+from .chain_kinematics import MAX_N, _Recorder, chain_inputs, joint_trig, revolute, turning_arg
 from .spatial import (
     Namer,
     add_inertia,
@@ -430,7 +430,8 @@ def specs_for(n: int) -> list[KernelSpec]:
     """The dynamics kernels of the n-joint chain. Forward dynamics, bias and energy call the mass
     matrix and inverse dynamics kernels (`Call`) rather than repeat their code: the bias is the
     inverse dynamics at θ'' = 0, forward dynamics solves M θ'' = τ − bias by Cholesky, and the
-    kinetic energy is ½ θ'ᵀMθ'."""
+    kinetic energy is ½ θ'ᵀMθ'. The mass matrix, inverse and forward dynamics also come in their
+    forms for chains of R-pairs (chain_kinematics.revolute), which the runtime takes for them."""
     asm = Assembly(n)
     base = list(asm.rec.steps)
     qd = [j["qd"] for j in asm.J]
@@ -465,6 +466,18 @@ def specs_for(n: int) -> list[KernelSpec]:
     tau_arg = Arg("tau", (n,), "joint torques tau_i [N m]", tuple(taus))
     qdm = sp.Matrix(qd)
     T = sp.expand((qdm.T * M_r * qdm)[0] / 2)
+    forward = KernelSpec(
+        f"forward_dynamics{n}",
+        f"Joint accelerations theta'' = M^-1 (tau - C theta' - g) ({n}) of a "
+        f"{n}-joint chain, by Cholesky (NaN where M is not positive definite).",
+        SOURCE,
+        asm.inputs("law", "qd") + [tau_arg] + asm.inputs("dh", "turning", *body, "gravity"),
+        [Arg("qdd", (n,), "joint accelerations [rad/s^2]", exprs=tuple(qdd_fd))],
+        f_steps,
+        calls=[call_M("law", "dh", "turning", "links", "legs"), call_bias],
+    )
+    # the hot kernels' forms for chains of R-pairs (no slide, pitch or leg terms)
+    twins = {k.name: revolute(k) for k in (mass, inverse)}
     return [
         mass,
         KernelSpec(
@@ -492,16 +505,7 @@ def specs_for(n: int) -> list[KernelSpec]:
             calls=[Call(inverse, ("law", "qd", None, "dh", "turning", "links", "legs", "gravity"), tuple(b_r))],
         ),
         inverse,
-        KernelSpec(
-            f"forward_dynamics{n}",
-            f"Joint accelerations theta'' = M^-1 (tau - C theta' - g) ({n}) of a "
-            f"{n}-joint chain, by Cholesky (NaN where M is not positive definite).",
-            SOURCE,
-            asm.inputs("law", "qd") + [tau_arg] + asm.inputs("dh", "turning", *body, "gravity"),
-            [Arg("qdd", (n,), "joint accelerations [rad/s^2]", exprs=tuple(qdd_fd))],
-            f_steps,
-            calls=[call_M("law", "dh", "turning", "links", "legs"), call_bias],
-        ),
+        forward,
         KernelSpec(
             f"energy{n}",
             f"Kinetic and potential energy (T, V) of a {n}-joint chain.",
@@ -511,6 +515,8 @@ def specs_for(n: int) -> list[KernelSpec]:
             base + asm.vrec.steps,
             calls=[call_M("law", "dh", "turning", "links", "legs")],
         ),
+        *twins.values(),
+        revolute(forward, twins),
     ]
 
 

@@ -22,7 +22,7 @@ import sympy as sp
 
 from .autodiff import directional
 from .quaternions import Quaternion, StudyPoint, rotation, translation
-from .spec import Arg, Entry, KernelSpec, PolynomialSet
+from .spec import Arg, Call, Entry, KernelSpec, PolynomialSet
 
 SOURCE = "derivations/chain_kinematics.py"
 MAX_N = 7
@@ -66,6 +66,40 @@ def chain_inputs(n: int) -> tuple[list[Arg], list[dict]]:
             design=True,
         ),
     ], J
+
+
+# An R-pair's values of the generic kernels' per-joint inputs: its angle is the joint variable
+# (w = 1), it does not slide (d and its derivatives d', d'', d''' = 0) and it has no legs (the
+# dynamics' leg mass m_leg = 0)
+REVOLUTE_VALUES = {"d": 0, "dd": 0, "ddd": 0, "dddd": 0, "w": 1, "ml": 0}
+
+
+def revolute(spec: KernelSpec, twins: dict[str, KernelSpec] | None = None) -> KernelSpec:
+    """`spec`'s kernel for chains of R-pairs, named <family>_revolute<n>: its steps and outputs with
+    REVOLUTE_VALUES put in, so that the slide, pitch and leg terms of the generic kernel drop out
+    (a third of the mass matrix's operations). The inputs are the generic kernel's (the values it
+    fixes are not read), so that a caller takes either with the same arguments; `twins` maps the
+    kernels `spec` calls to their R-chain forms."""
+    family = spec.name.rstrip("0123456789")
+    n = spec.name[len(family) :]
+    values = {}
+    for a in spec.inputs:
+        for s in a.symbols:
+            field, _, joint = s.name.rpartition("_")
+            if field in REVOLUTE_VALUES and joint.isdigit():
+                values[s] = sp.S(REVOLUTE_VALUES[field])
+    put = lambda e: sp.S(e).xreplace(values)
+    twins = twins or {}
+    return KernelSpec(
+        name=f"{family}_revolute{n}",
+        doc=f"{spec.doc} Chains of R-pairs only: reads neither the law's d, d', d'' (nor d''') nor turning or legs.",
+        source=spec.source,
+        inputs=spec.inputs,
+        outputs=[Arg(a.name, a.shape, a.doc, exprs=tuple(put(e) for e in a.exprs)) for a in spec.outputs],
+        steps=[(s, put(e)) for s, e in spec.steps],
+        calls=[Call(twins[c.kernel.name], c.args, c.results) for c in spec.calls],
+        wide=spec.wide,
+    )
 
 
 def at_angles(J: list[dict]) -> dict:
@@ -378,5 +412,6 @@ def derive():
     checks = {n: check_jacobian(n) for n in (1, 2, 3)}
     specs = []
     for n in range(1, MAX_N + 1):
-        specs += [fk_spec(n), fk_study_spec(n), jacobian_spec(n), jacobian_dot_spec(n)]
+        fk, jacobian = fk_spec(n), jacobian_spec(n)
+        specs += [fk, fk_study_spec(n), jacobian, jacobian_dot_spec(n), revolute(fk), revolute(jacobian)]
     return [joint_polynomials(), chain_study_polynomials(2)], specs, {"jacobian_check": checks}

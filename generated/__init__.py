@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: d3341f82ae451eb8
+Content hash: 32c401558f5349ec
 """

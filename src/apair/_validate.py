@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -159,4 +161,36 @@ def integer(name: str, value: object, minimum: int = 1, maximum: int | None = No
         raise ValueError(f"{name}: must be >= {minimum}, got {out}")
     if maximum is not None and out > maximum:
         raise ValueError(f"{name}: must be <= {maximum}, got {shorten(str(out))}")
+    return out
+
+
+def joint_limits(pairs: Sequence[Any], limits: Iterable[ArrayLike | None] | None) -> list[tuple[float, float] | None]:
+    """A chain's explicit joint ranges (one (lo, hi) or None per pair, None: the pair's own), checked:
+    lo < hi within the pair's range of motion (`motion_range()`), and given for every P-pair."""
+    n = len(pairs)
+    if limits is None:
+        limits = [None] * n
+    try:
+        entries = list(limits)
+    except TypeError as exc:
+        raise ValueError(f"limits: expected one (lo, hi) or None per pair, got {shorten(repr(limits))}") from exc
+    if len(entries) != n:
+        raise ValueError(f"limits: expected {n} entries (one per pair), got {len(entries)}")
+    out: list[tuple[float, float] | None] = []
+    for i, lim in enumerate(entries):
+        if lim is None and pairs[i].kind == "prismatic":
+            raise ValueError(f"limits[{i}]: joint {i + 1} is prismatic: give its range (lo, hi) in metres")
+        if lim is None:
+            out.append(None)
+            continue
+        lo, hi = vector(f"limits[{i}]", lim, 2)
+        if not lo < hi:
+            raise ValueError(f"limits[{i}]: expected lo < hi, got ({lo}, {hi})")
+        plo, phi = pairs[i].motion_range()
+        if lo < plo or hi > phi:
+            raise ValueError(
+                f"limits[{i}]: ({lo:.6g}, {hi:.6g}) rad goes beyond joint {i + 1}'s collision-free "
+                f"range ({plo:.6g}, {phi:.6g}) rad"
+            )
+        out.append((float(lo), float(hi)))
     return out

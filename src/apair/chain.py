@@ -24,7 +24,7 @@ from .files import write_text
 from .frames import EYE4, FramedLocal, check_frame, inverse
 from .hold import held_ik
 from .ik.families import Classification, classify
-from .kernels import call, native_chain
+from .kernels import call, chain_kernel, native_chain
 from .link import Link
 from .pair import APair
 from .study import from_matrix, multiply, normalise
@@ -135,6 +135,7 @@ class AChain:
         self._links = np.ascontiguousarray(np.stack([link.as_row() for link in links]))
         self._legs = np.array([[p.leg_mass, p.base_radius, p.platform_radius] for p in pair_list])
         self._turning = np.array([p.turning for p in pair_list])  # dθ/dq: 0 for a P-pair
+        self._revolute = all(p.kind == "revolute" for p in pair_list)  # kernels.REVOLUTE's forms
         self._base_T, self._tool_T = check_frame("base", base), check_frame("tool", tool)
         self._framed = self._base_T is not None or self._tool_T is not None
         # the kernels' gravity is in the DH base frame (frame 0): Rbᵀ·g
@@ -145,7 +146,7 @@ class AChain:
         self._law_groups = self._group_laws()
         self._ranged = [i for i, p in enumerate(pair_list) if p.theta_limit is not None]  # angles to check
         self._ik: Solver | None = None  # the inverse-kinematics solver, built on the first call of ik()
-        self._explicit_limits = self._check_limits(limits)
+        self._explicit_limits = V.joint_limits(pair_list, limits)
         self._use(self._native_chain())
 
     def _use(self, fast: FastPath) -> None:
@@ -229,35 +230,6 @@ class AChain:
         self.__dict__.update(state)
         self._use(self._native_chain())
 
-    def _check_limits(self, limits: Iterable[ArrayLike | None] | None) -> list[tuple[float, float] | None]:
-        slides = [i for i, p in enumerate(self.pairs) if p.kind == "prismatic"]
-        if limits is None:
-            limits = [None] * self.n
-        try:
-            entries = list(limits)
-        except TypeError as exc:
-            raise ValueError(f"limits: expected one (lo, hi) or None per pair, got {V.shorten(repr(limits))}") from exc
-        if len(entries) != self.n:
-            raise ValueError(f"limits: expected {self.n} entries (one per pair), got {len(entries)}")
-        out: list[tuple[float, float] | None] = []
-        for i, lim in enumerate(entries):
-            if lim is None and i in slides:
-                raise ValueError(f"limits[{i}]: joint {i + 1} is prismatic: give its range (lo, hi) in metres")
-            if lim is None:
-                out.append(None)
-                continue
-            lo, hi = V.vector(f"limits[{i}]", lim, 2)
-            if not lo < hi:
-                raise ValueError(f"limits[{i}]: expected lo < hi, got ({lo}, {hi})")
-            plo, phi = self.pairs[i].motion_range()
-            if lo < plo or hi > phi:
-                raise ValueError(
-                    f"limits[{i}]: ({lo:.6g}, {hi:.6g}) rad goes beyond joint {i + 1}'s collision-free "
-                    f"range ({plo:.6g}, {phi:.6g}) rad"
-                )
-            out.append((float(lo), float(hi)))
-        return out
-
     @property
     def limits(self) -> NDArray[np.float64]:
         """(n, 2): each joint's range [rad; m for a P-pair]: the explicit one if given, else the pair's collision
@@ -307,14 +279,18 @@ class AChain:
 
     def _native_chain(self) -> FastPath:
         """The native fast path of the methods (apair.kernels.native_chain): per method its
-        generic chain kernel, fed by the pairs' law kernels."""
+        chain kernel (`_kernel`), fed by the pairs' law kernels."""
         return native_chain(
             self.n,
-            [(tuple(f"{k}{self.n}" for k in D.kernels_of(family)), strict) for family, strict in METHODS],
+            [(tuple(self._kernel(k) for k in D.kernels_of(family)), strict) for family, strict in METHODS],
             [p.law_kernel for p in self.pairs],
             [p.theta_limit if p.theta_limit is not None else math.inf for p in self.pairs],
             dict(zip(("dh", "turning", "links", "legs", "gravity"), self._body)),
         )
+
+    def _kernel(self, family: str) -> str:
+        """The name of this chain's kernel of `family` (kernels.chain_kernel)."""
+        return chain_kernel(family, self.n, self._revolute)
 
     def law(self, q: ArrayLike) -> NDArray[np.float64]:
         """(..., n, 3): each joint's (d, d', d'') at q."""
@@ -376,7 +352,7 @@ class AChain:
             law = self._law(arrays[0])
             if strict and not np.isfinite(law).all():
                 raise ValueError("q: a joint is at its pair's limit, where d'(theta) is unbounded")
-            out = call(f"{family}{self.n}", law, *arrays[1:], *design)[0]
+            out = call(self._kernel(family), law, *arrays[1:], *design)[0]
         if framed and self._framed and method <= 2:
             out = self._compose(method, out, arrays[0])
         return out

@@ -55,6 +55,7 @@ class DynamicsChain(Protocol):
 
     def _state(self, q: ArrayLike, strict: bool = ..., **named: ArrayLike) -> list[NDArray[np.float64]]: ...
     def _law(self, q: NDArray[np.float64]) -> NDArray[np.float64]: ...
+    def _kernel(self, family: str) -> str: ...
 
 
 def third_derivatives(chain: DynamicsChain, q: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -91,9 +92,9 @@ def inverse_dynamics_derivatives(
     if out is not None:
         return out
     law, dddd = _law(chain, q_)
-    n, body = chain.n, chain._body
-    dq, dqd = call(f"inverse_dynamics_derivatives{n}", law, dddd, qd_, qdd_, *body)
-    M = call(f"mass_matrix{n}", law, *body[:4])[0]  # dh, turning, links, legs
+    body = chain._body
+    dq, dqd = call(chain._kernel("inverse_dynamics_derivatives"), law, dddd, qd_, qdd_, *body)
+    M = call(chain._kernel("mass_matrix"), law, *body[:4])[0]  # dh, turning, links, legs
     return dq, dqd, M
 
 
@@ -109,7 +110,7 @@ def forward_dynamics_derivatives(
     out = _fast(chain, method, q_, qd_, tau_) if method >= 0 else None
     if out is None:  # the generic kernels (NaN where M is not positive definite)
         law, dddd = _law(chain, q_)
-        out = call(f"forward_dynamics_derivatives{chain.n}", law, dddd, qd_, tau_, *chain._body)
+        out = call(chain._kernel("forward_dynamics_derivatives"), law, dddd, qd_, tau_, *chain._body)
     if not all(np.isfinite(x).all() for x in out):
         raise ValueError(
             "links: the mass matrix is not positive definite at this q (give every moving body mass and inertia)"
@@ -147,7 +148,7 @@ def _framed_jacobian_dot(
         F, J0 = chain._fast.call(0, q), chain._fast.call(2, q)
         if F is None or J0 is None:
             law, body = chain._law(q), chain._body
-            F, J0 = call(f"fk{chain.n}", law, body[0])[0], call(f"jacobian{chain.n}", law, *body[:2])[0]
+            F, J0 = call(chain._kernel("fk"), law, body[0])[0], call(chain._kernel("jacobian"), law, *body[:2])[0]
         Sr = _skew(F[..., :3, :3] @ tool[:3, 3])
         Jw0 = J0[..., 3:, :]
         r_dot = -Sr @ (Jw0 @ qd[..., None])  # ω_n × r

@@ -197,6 +197,27 @@ def call(name: str, *inputs: ArrayLike) -> list[NDArray[np.float64]]:
     return list(result) if isinstance(result, tuple) else [result]
 
 
+# The chain-kernel families with a form for chains of R-pairs (<family>_revolute<n>: the generic
+# kernel without its slide, pitch and leg terms, with the same inputs), which such chains call.
+REVOLUTE = frozenset(
+    {
+        "fk",
+        "jacobian",
+        "mass_matrix",
+        "inverse_dynamics",
+        "forward_dynamics",
+        "inverse_dynamics_derivatives",
+        "forward_dynamics_derivatives",
+    }
+)
+
+
+def chain_kernel(family: str, n: int, revolute: bool) -> str:
+    """The name of the n-joint chain kernel of `family`: its form for chains of R-pairs where it has
+    one (REVOLUTE) and `revolute` (every pair of the chain an R-pair), else the generic kernel."""
+    return f"{family}_revolute{n}" if revolute and family in REVOLUTE else f"{family}{n}"
+
+
 class FastPath(Protocol):
     """A chain's native fast path (`native_chain`)."""
 

@@ -443,8 +443,8 @@ def load(
     """The native fast path of the chain's specialised kernels (kernels.native_chain) for the
     chain's `methods` ((kernel family, strict) in the order of its fast path: apair.chain.METHODS)
     and the loaded library, or None (no compiler, or the C backend is not installed). A method
-    whose kernel was not chosen (or has no specialised form: jacobian_dot) gets the generic one,
-    fed by the law kernels, as on the chain's generic fast path."""
+    whose kernel was not chosen (or has no specialised form: jacobian_dot) gets the chain's
+    kernel of it (AChain._kernel), fed by the law kernels, as on the chain's generic fast path."""
     import ctypes
 
     from . import kernels as _kernels
@@ -467,7 +467,7 @@ def load(
         raise RuntimeError(f"specialise: {library} holds {count} kernels, expected {len(names)}: remove it")
     base = ctypes.addressof(ctypes.c_char.in_dll(lib, f"{name}_registry"))
     families = {f: k for k, f in _toolkit()[0].KERNELS.items()}
-    kernel = lambda family: families[family] if families.get(family) in names else f"{family}{chain.n}"
+    kernel = lambda family: families[family] if families.get(family) in names else chain._kernel(family)
     fast = _kernels.native_chain(
         chain.n,
         [(tuple(kernel(f) for f in kernels_of(family)), strict) for family, strict in methods],

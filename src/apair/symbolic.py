@@ -49,12 +49,13 @@ def to_casadi(chain: ChainLike) -> dict[str, Any]:
     def matrix(entries: list[Any], rows: int, cols: int) -> Any:
         return ca.reshape(ca.vertcat(*entries), cols, rows).T  # the kernels' row-major order
 
-    T = matrix(K[f"fk{n}"](law, dh)[0], 4, 4)
-    J = matrix(K[f"jacobian{n}"](law, dh, turning)[0], 6, n)
+    of = lambda family: K[chain._kernel(family)]  # an R-chain's own where it has one
+    T = matrix(of("fk")(law, dh)[0], 4, 4)
+    J = matrix(of("jacobian")(law, dh, turning)[0], 6, n)
     T, J = _framed(ca, chain, T, J)
-    M = matrix(K[f"mass_matrix{n}"](law, dh, turning, links, legs)[0], n, n)
-    tau_id = ca.vertcat(*K[f"inverse_dynamics{n}"](law, qd, qdd, dh, turning, links, legs, gravity)[0])
-    qdd_fd = ca.vertcat(*K[f"forward_dynamics{n}"](law, qd, tau, dh, turning, links, legs, gravity)[0])
+    M = matrix(of("mass_matrix")(law, dh, turning, links, legs)[0], n, n)
+    tau_id = ca.vertcat(*of("inverse_dynamics")(law, qd, qdd, dh, turning, links, legs, gravity)[0])
+    qdd_fd = ca.vertcat(*of("forward_dynamics")(law, qd, tau, dh, turning, links, legs, gravity)[0])
     return {
         "fk": ca.Function("fk", [q], [T], ["q"], ["T"]),
         "jacobian": ca.Function("jacobian", [q], [J], ["q"], ["J"]),
