@@ -496,9 +496,9 @@ def native_section(rng, quick: bool) -> dict:
             derivatives=label != "examples/4a_chain.toml",  # the two n = 6 chains
         )
     manifest = kernels.manifest()["kernels"]
-    r_chain = random_chain(6, np.random.default_rng(0))  # its kernels: those of every 6-joint R-chain
-    out["apair_ops_per_item"] = {
-        op: manifest[r_chain._kernel(op)]["ops_per_item"] for op in (*native.OPERATIONS, *native.DERIVATIVES)
+    out["apair_ops_per_item"] = {  # the R-chain's kernels
+        op: manifest[kernels.chain_kernel(op, 6, revolute=True)]["ops_per_item"]
+        for op in (*native.OPERATIONS, *native.DERIVATIVES)
     }
     return out
 

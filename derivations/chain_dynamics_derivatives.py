@@ -25,7 +25,7 @@ import sympy as sp
 
 from .autodiff import gradient
 from .chain_dynamics import Assembly, rnea, specs_for
-from .chain_kinematics import MAX_N, _Recorder, revolute
+from .chain_kinematics import MAX_N, _Recorder, revolute, revolute_name
 from .spec import Arg, Call, KernelSpec
 
 SOURCE = "derivations/chain_dynamics_derivatives.py"
@@ -177,7 +177,7 @@ def specs_for_n(n: int) -> list[KernelSpec]:
     )
     # their forms for chains of R-pairs (chain_kinematics.revolute: about 40 % fewer operations), the
     # forward dynamics' calling the R-chain mass matrix and inverse dynamics
-    twins = {k.name: base[k.name.replace(str(n), f"_revolute{n}")] for k in (mass, inverse)}
+    twins = {k.name: base[revolute_name(k.name)] for k in (mass, inverse)}
     return [id_spec, fd_spec, revolute(id_spec), revolute(fd_spec, twins)]
 
 

@@ -74,14 +74,18 @@ def chain_inputs(n: int) -> tuple[list[Arg], list[dict]]:
 REVOLUTE_VALUES = {"d": 0, "dd": 0, "ddd": 0, "dddd": 0, "w": 1, "ml": 0}
 
 
+def revolute_name(name: str) -> str:
+    """The name of kernel `name`'s form for chains of R-pairs: <family><n> -> <family>_revolute<n>."""
+    family = name.rstrip("0123456789")
+    return f"{family}_revolute{name[len(family) :]}"
+
+
 def revolute(spec: KernelSpec, twins: dict[str, KernelSpec] | None = None) -> KernelSpec:
     """`spec`'s kernel for chains of R-pairs, named <family>_revolute<n>: its steps and outputs with
     REVOLUTE_VALUES put in, so that the slide, pitch and leg terms of the generic kernel drop out
     (a third of the mass matrix's operations). The inputs are the generic kernel's (the values it
     fixes are not read), so that a caller takes either with the same arguments; `twins` maps the
     kernels `spec` calls to their R-chain forms."""
-    family = spec.name.rstrip("0123456789")
-    n = spec.name[len(family) :]
     values = {}
     for a in spec.inputs:
         for s in a.symbols:
@@ -91,7 +95,7 @@ def revolute(spec: KernelSpec, twins: dict[str, KernelSpec] | None = None) -> Ke
     put = lambda e: sp.S(e).xreplace(values)
     twins = twins or {}
     return KernelSpec(
-        name=f"{family}_revolute{n}",
+        name=revolute_name(spec.name),
         doc=f"{spec.doc} Chains of R-pairs only: reads neither the law's d, d', d'' (nor d''') nor turning or legs.",
         source=spec.source,
         inputs=spec.inputs,
