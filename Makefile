@@ -76,7 +76,7 @@ check: install
 	  (echo "$(EXAMPLE_CODE) is out of date: run make examples and commit" >&2; exit 1)
 
 test: install lib check browser clang
-	$(PY) -m pytest -q --durations=20
+	$(PY) -m pytest -q -n $(NPROC) --durations=30
 
 # The fast tier (a few minutes): every test not marked slow, without regenerating generated/.
 test-fast: install lib browser

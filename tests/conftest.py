@@ -44,3 +44,23 @@ def backend(request):
     apair.set_backend(request.param)
     yield request.param
     apair.set_backend(None)
+
+
+# The files whose tests share the session's derivations (the fixture above, about two minutes):
+# under pytest-xdist they go to one worker, so it is derived once.
+SHARED_DERIVATIONS = {"tests/derivation/test_derivations.py", "tests/derivation/test_kernels_symbolic.py"}
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """Under pytest-xdist (`make test` runs two workers) each file's tests stay on one worker, as with
+    `--dist loadfile`: its module fixtures (some are C builds of a minute) are made once; and the two
+    files of SHARED_DERIVATIONS share one worker. (xdist's `loadgroup` marks do not group under
+    pytest 9.)"""
+    from xdist.scheduler import LoadFileScheduling
+
+    class Scheduling(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            path = super()._split_scope(nodeid)
+            return "derivations" if path in SHARED_DERIVATIONS else path
+
+    return Scheduling(config, log)
