@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 32c401558f5349ec
+Content hash: d65977d38fd3b62b
 """

@@ -14,6 +14,7 @@
 #define CLOSED_SINGULAR 1e-7  /* an angle this close to 0 or pi (at a double root) is taken as there */
 #define CLOSED_DOUBLE 1e-14   /* a squared sine within this (relative) of 0: one root, not two */
 #define CLOSED_TANGENT 1e-8  /* a local extremum of the polynomial this close to 0 (relative) is a root */
+#define CLOSED_SPLIT 1e-6    /* two real roots of a quadratic this far apart (relative) are two, not a split double root */
 #define CLOSED_INV_MAX 1024
 #define CLOSED_DEGREE 12 /* the highest degree closed_real_roots takes (the A-pair UR arm's polynomial) */
 #define CLOSED_ROOTS 64 /* room for closed_real_roots' answer: 3 for d = 2, at most 2 n(d - 1) + 1 above (15 for
@@ -67,16 +68,20 @@ static int closed_real_roots(int d, const double *c, double *roots)
     if (d <= 0) return 0;
     if (d == 1) { roots[0] = -c[0] / c[1]; return 1; }
     if (d == 2) { /* the stable formula; a discriminant within CLOSED_TANGENT of 0: the double root too (the
-                   * critical point, exact where the two roots are sqrt(eps) off it) */
+                   * critical point, exact where the two roots are sqrt(eps) off it, or complex by rounding),
+                   * but not between two real roots CLOSED_SPLIT apart: two solutions, and the point between
+                   * them nearly verifies (to 3e-11 on a PUMA's pose with roots 1.7e-5 apart) */
         double disc = c[1] * c[1] - 4 * c[2] * c[0], near = fabs(disc) <= CLOSED_TANGENT * (c[1] * c[1] + fabs(4 * c[2] * c[0]) + c[2] * c[2]);
+        double mid = -c[1] / (2 * c[2]);
         int n = 0;
         if (disc >= 0) {
             double qq = -0.5 * (c[1] + copysign(sqrt(disc), c[1]));
             double r1 = qq / c[2], r2 = qq != 0.0 ? c[0] / qq : -r1;
             roots[n++] = fmin(r1, r2);
             roots[n++] = fmax(r1, r2);
+            if (fabs(r1 - r2) > CLOSED_SPLIT * (1.0 + fabs(mid))) near = 0;
         }
-        if (near) roots[n++] = -c[1] / (2 * c[2]);
+        if (near) roots[n++] = mid;
         return n;
     }
     double dc[CLOSED_DEGREE], crit[CLOSED_ROOTS];
