@@ -52,7 +52,7 @@ SHARED_DERIVATIONS = {"tests/derivation/test_derivations.py", "tests/derivation/
 
 
 def pytest_xdist_make_scheduler(config, log):
-    """Under pytest-xdist (`make test` runs two workers) each file's tests stay on one worker, as with
+    """Under pytest-xdist (`make test` runs a worker per core) each file's tests stay on one worker, as with
     `--dist loadfile`: its module fixtures (some are C builds of a minute) are made once; and the two
     files of SHARED_DERIVATIONS share one worker. (xdist's `loadgroup` marks do not group under
     pytest 9.)"""

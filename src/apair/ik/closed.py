@@ -30,7 +30,8 @@ def real_roots(coeffs: NDArray[np.float64], ref: float) -> tuple[list[float], bo
         return [], at_infinity
     poly = c[: top + 1][::-1]
     t = np.roots(poly)
-    roots = _polish(poly, t[np.abs(t.imag) <= ROOT_IMAG * (1 + np.abs(t))].real).tolist()
+    real = t[np.abs(t.imag) <= ROOT_IMAG * (1 + np.abs(t))].real
+    roots = _polish(poly, real).tolist()
     # a critical point where the polynomial (nearly) vanishes: a double root, exact where the two
     # roots come sqrt(eps) off it (as the C twin, apair_ik_closed.h); a quadratic's by its
     # discriminant, and not between two real roots SPLIT apart (two solutions: the point between them
@@ -39,8 +40,7 @@ def real_roots(coeffs: NDArray[np.float64], ref: float) -> tuple[list[float], bo
         c2, c1, c0 = poly
         disc = c1 * c1 - 4 * c2 * c0
         mid = -c1 / (2 * c2)
-        real = np.sort(t[np.abs(t.imag) <= ROOT_IMAG * (1 + np.abs(t))].real)
-        split = disc >= 0 and len(real) == 2 and real[1] - real[0] > SPLIT * (1 + abs(mid))
+        split = disc >= 0 and len(real) == 2 and abs(real[1] - real[0]) > SPLIT * (1 + abs(mid))
         if abs(disc) <= TANGENT * (c1 * c1 + abs(4 * c2 * c0) + c2 * c2) and not split:
             roots.append(float(mid))
     elif top > 2:
