@@ -7,11 +7,14 @@ general solver), side by side on the same poses in one run
 EAIK's `IK(T)`, IK-Geo's `get_ik(R, t)`, interleaved pose by pose), apair's batched C call
 (`apair._native.ik_wrist` or `ik_parallel` on N poses) against
 EAIK's `IK_batched`, and how the solution sets agree (every solution of a peer that apair's fk
-verifies must be among apair's). The load average is recorded with the numbers."""
+verifies must be among apair's); and random 6R arms of no special geometry (the 6R elimination in
+one C call) against IK-Geo's general solver, with `prepare_ik` on every R arm. The load average is
+recorded with the numbers."""
 
 from __future__ import annotations
 
 import os
+import tempfile
 import time
 
 import numpy as np
@@ -182,7 +185,109 @@ def section(quick: bool) -> dict:
             flush=True,
         )
     out["a_pair_arms"] = a_pair_section(quick)
+    out["general_6r"] = general_section(quick)
     return out
+
+
+GENERAL_DESIGNS = 3  # random 6R designs (twists, lengths and offsets drawn as tests/ik/test_ik6r.py's random_arm)
+
+
+def general_section(quick: bool) -> dict:
+    """Six R-pairs of no special geometry (the 6R elimination in one C call, apair_ik6r): apair's single
+    Python call against IK-Geo's general solver (`gen_six_dof`: about one least-squares approximation
+    per pose, not every solution; EAIK refuses these arms), on the same poses; the share of
+    poses certified by the elimination and whether each pose's own joints are among the answers; and
+    `prepare_ik` (the homotopy's start system, into an empty cache) on each of these designs and on every
+    R arm of `ARMS`."""
+    count = 60 if quick else 300
+    rng = np.random.default_rng(7)
+    out: dict = {"designs": {}, "prepare_s": {}}
+    designs = {
+        f"random 6R #{k + 1}": apair.AChain(
+            [apair.APair.revolute()] * 6,
+            rng.uniform(0.1, 0.5, 6),
+            rng.uniform(-1.5, 1.5, 6),
+            rng.uniform(-0.2, 0.2, 6),
+            rng.uniform(-1.0, 1.0, 6),
+        )
+        for k in range(GENERAL_DESIGNS)
+    }
+    for name, chain in designs.items():
+        geo = _ikgeo_general(chain)
+        qs = rng.uniform(-PI, PI, (count, 6))
+        Ts = chain.fk(qs)
+        chain.ik(Ts[0])
+        times: dict[str, list[float]] = {"apair": []} | ({"ik_geo_general": []} if geo else {})
+        found = certified = 0
+        for q, T in zip(qs, Ts):  # each solver over all poses in turn: IK-Geo's general solver takes
+            t0 = time.perf_counter()  # milliseconds a pose, and would leave apair's calls a cold cache
+            ours = chain.ik(T)
+            times["apair"].append(time.perf_counter() - t0)
+            found += _among(q, ours)
+        for T in Ts if geo is not None else ():
+            t0 = time.perf_counter()
+            geo(T)
+            times["ik_geo_general"].append(time.perf_counter() - t0)
+        for T in Ts[: count // 3]:  # the route and its certificate (full=True takes the validating path)
+            sol = chain.ik(T, full=True)
+            certified += sol.certified and sol.method == "elimination"
+        out["designs"][name] = {
+            "median_us": {k: float(np.median(v) * 1e6) for k, v in times.items()},
+            "poses": count,
+            "own_joints_found": found,
+            "certified_by_elimination": certified,
+            "checked_for_route": count // 3,
+        }
+        med = out["designs"][name]["median_us"]
+        print(
+            f"  {name:19s} general                          single call: apair {med['apair']:7.1f} µs"
+            + (f", IK-Geo's general (approximate) {med['ik_geo_general']:7.1f} µs" if geo else "")
+            + f"; own joints found at {found}/{count}, certified by the elimination at {certified}/{count // 3}",
+            flush=True,
+        )
+    arms = {
+        name: apair.AChain([apair.APair.revolute()] * 6, a=a, alpha=al, offset=d) for name, (a, al, d) in ARMS.items()
+    }
+    old = os.environ.get("APAIR_CACHE")
+    with tempfile.TemporaryDirectory() as tmp:
+        os.environ["APAIR_CACHE"] = tmp
+        try:
+            for name, chain in (designs | arms).items():
+                t0 = time.perf_counter()
+                chain.prepare_ik()
+                out["prepare_s"][name] = time.perf_counter() - t0
+        finally:
+            if old is None:
+                os.environ.pop("APAIR_CACHE", None)
+            else:
+                os.environ["APAIR_CACHE"] = old
+    worst = max(out["prepare_s"], key=out["prepare_s"].get)
+    print(
+        f"  prepare_ik: at most {out['prepare_s'][worst]:.2f} s ({worst}) over {len(out['prepare_s'])} 6R arms",
+        flush=True,
+    )
+    return out
+
+
+def _ikgeo_general(chain):
+    """IK-Geo's general 6R solver (`gen_six_dof`) on the chain's axes, T -> its answer, or None where
+    IK-Geo or EAIK (whose DH reading gives the axes) is missing."""
+    try:
+        import ik_geo
+        from eaik.IK_DH import DhRobot
+    except ImportError:
+        return None
+    robot = DhRobot(np.asarray(chain.alpha, float), np.asarray(chain.a, float), np.asarray(chain.offset, float))
+    H, P = np.asarray(robot.getOriginal_H()).T, np.asarray(robot.getOriginal_P()).T
+    geo = ik_geo.Robot.gen_six_dof(H.tolist(), P.tolist())
+    R0, _ = geo.forward_kinematics([0.0] * 6)
+    tool = np.asarray(R0) @ chain.fk(np.zeros(6))[:3, :3]
+
+    def solve(T):
+        R = (T[:3, :3] @ tool.T).T
+        return geo.get_ik(R.tolist(), T[:3, 3].tolist())
+
+    return solve
 
 
 A_ARMS = {  # UR arms with sinusoidal A-pairs (r_b = 0.06, r_p = 0.05: h = 0.0775 m) at these joints (from 1)
@@ -263,7 +368,8 @@ def _timed(fn) -> float:
 
 
 def targets(r: dict) -> list[dict]:
-    """Issue 42's targets for the special R arms (spherical wrist, UR), each met or missed."""
+    """Issue 42's targets for the special R arms (spherical wrist, UR), the general 6R arms and the arms
+    with A-pairs, each met or missed."""
     out = []
     for name, row in r["arms"].items():
         med = row["median_us"]
@@ -282,6 +388,20 @@ def targets(r: dict) -> list[dict]:
                 "met": row["eaik_solutions_missing_from_apair"] == 0,
             }
         )
+    general = r.get("general_6r", {})
+    for name, row in general.get("designs", {}).items():
+        us = row["median_us"]["apair"]
+        out.append({"target": f"{name}: single call <= 0.3 ms (300 µs) per pose", "measured": us, "met": us <= 300.0})
+        out.append(
+            {
+                "target": f"{name}: every pose's own joints among the answers",
+                "measured": row["poses"] - row["own_joints_found"],
+                "met": row["own_joints_found"] == row["poses"],
+            }
+        )
+    if general.get("prepare_s"):
+        worst = max(general["prepare_s"].values())
+        out.append({"target": "prepare_ik <= 1 s on every 6R arm benched", "measured": worst, "met": worst <= 1.0})
     for name, row in r.get("a_pair_arms", {}).items():
         us = row["median_us"]["closed_form"]
         out.append({"target": f"{name}: <= 50 µs per pose", "measured": us, "met": us <= 50.0})

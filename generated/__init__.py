@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: d65977d38fd3b62b
+Content hash: 85f14830db18faca
 """

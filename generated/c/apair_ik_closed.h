@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_closed.h (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_closed.h. Content hash: 864a527dee086770
+ * generated/c. Do not edit: edit src/csrc/apair_ik_closed.h. Content hash: 26cbc94cc95ca874
  */
 /*
  * Private to the closed-form solvers of six-joint chains (apair_ik_wrist.c, apair_ik_parallel.c,
@@ -37,7 +37,7 @@ typedef struct {
 } closed_fk;
 
 /* 0, or -1 where the kernels are missing or too big for the buffers */
-static int closed_fk_init(closed_fk *k, const double *dh)
+static inline int closed_fk_init(closed_fk *k, const double *dh)
 {
     k->fk = apair_find_kernel("fk6");
     k->jac = apair_find_kernel("jacobian6");
@@ -49,14 +49,14 @@ static int closed_fk_init(closed_fk *k, const double *dh)
     return 0;
 }
 
-static double closed_horner(int d, const double *c, double x)
+static inline double closed_horner(int d, const double *c, double x)
 {
     double s = c[d];
     for (int k = d - 1; k >= 0; k--) s = s * x + c[k];
     return s;
 }
 
-static double closed_magnitude(int d, const double *c, double x)
+static inline double closed_magnitude(int d, const double *c, double x)
 {
     double s = 0.0, ax = fabs(x), p = 1.0;
     for (int k = 0; k <= d; k++, p *= ax) s += fabs(c[k]) * p;
@@ -67,7 +67,7 @@ static double closed_magnitude(int d, const double *c, double x)
  * 1): a root in each interval between the real roots of the derivative where the sign changes, and
  * each critical point within CLOSED_TANGENT of zero (a double root, or two roots too close to
  * separate): candidates, some repeated, at most 3 for d = 2 and 15 for d = 4, CLOSED_ROOTS in all. */
-static int closed_real_roots(int d, const double *c, double *roots)
+static inline int closed_real_roots(int d, const double *c, double *roots)
 {
     if (d <= 0) return 0;
     if (d == 1) { roots[0] = -c[0] / c[1]; return 1; }
@@ -161,7 +161,7 @@ static inline int closed_half_angles(int deg, const double *c, double ref, doubl
 
 /* fk and (if J) the Jacobian (6 x 6) at joint angles q; the pose error e as apair.ik.poses:
  * [(t_T - t) / scale; rotation]; returns the largest entry of |fk - T|, translations / scale. */
-static double closed_evaluate(const closed_fk *w, const double *dh, double scale, const double *q, const double *Tt,
+static inline double closed_evaluate(const closed_fk *w, const double *dh, double scale, const double *q, const double *Tt,
                        double *e, double *J)
 {
     double law[30], T[16];
@@ -196,7 +196,7 @@ static double closed_evaluate(const closed_fk *w, const double *dh, double scale
 }
 
 /* Up to two Gauss-Newton steps (as apair.ik.poses.refine); the error of the result. */
-static double closed_polish(const closed_fk *w, const double *dh, double scale, const double *Tt, double tol, double *q)
+static inline double closed_polish(const closed_fk *w, const double *dh, double scale, const double *Tt, double tol, double *q)
 {
     double e[6], J[36];
     double err = closed_evaluate(w, dh, scale, q, Tt, e, NULL);
@@ -218,7 +218,7 @@ static double closed_polish(const closed_fk *w, const double *dh, double scale, 
     return err;
 }
 
-static int closed_same_angles(const double *a, const double *b)
+static inline int closed_same_angles(const double *a, const double *b)
 {
     for (int i = 0; i < 6; i++)
         if (fabs(closed_wrap(a[i] - b[i])) >= 1e-6) return 0;
@@ -226,18 +226,23 @@ static int closed_same_angles(const double *a, const double *b)
 }
 
 /* x (verified, error err) into the solutions of one pose: a duplicate of one kept (closed_same_angles)
- * replaces it where its error is smaller; at most CLOSED_MAX kept */
-static void closed_keep(double *q, double *error, int *found, const double *x, double err)
+ * replaces it where its error is smaller; at most `most` kept */
+static inline void closed_keep_at_most(double *q, double *error, int *found, const double *x, double err, int most)
 {
     for (int k = 0; k < *found; k++)
         if (closed_same_angles(q + 6 * k, x)) {
             if (err < error[k]) { memcpy(q + 6 * k, x, 6 * sizeof *x); error[k] = err; }
             return;
         }
-    if (*found < CLOSED_MAX) {
+    if (*found < most) {
         memcpy(q + 6 * *found, x, 6 * sizeof *x);
         error[(*found)++] = err;
     }
+}
+
+static inline void closed_keep(double *q, double *error, int *found, const double *x, double err) /* at most CLOSED_MAX */
+{
+    closed_keep_at_most(q, error, found, x, err, CLOSED_MAX);
 }
 
 /* The A-pair arms' closed forms (apair_ik_parallel.c, apair_ik_wrist.c): an A-pair's angle has period

@@ -42,6 +42,9 @@ extern PyTypeObject apair_native_local_ik_type;
  * shape (size,) or (4, 4) (nd), finite, copied into out (1, else 0); T clearly rigid (1, else 0) */
 int apair_native_canonical(PyObject *obj, int nd, npy_intp size, double *out);
 int apair_native_rigid(const double *T);
+/* and LAPACK for apair_ik6r_solve and apair_ik6r: SciPy's (scipy.linalg.cython_lapack), loaded on the
+ * first call (with the GIL; NULL with an ImportError set where it cannot be) */
+const apair_lapack *apair_native_lapack(void);
 
 /* _native_closed.c: the type apair._native.ClosedIK (the single-pose fast path of AChain.ik for
  * the chains solved in closed form) */

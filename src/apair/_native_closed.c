@@ -14,9 +14,13 @@
  */
 #include "_native.h"
 
+#define GENERAL_6R 128 /* six R-pairs of no closed-form family: the 6R elimination (apair_ik6r) */
+
 typedef struct {
     PyObject_HEAD
-    apair_ik_closed *solver; /* PyMem_Malloc'd (about 32 kB), prepared by apair_ik_closed_init */
+    apair_ik_closed *solver; /* PyMem_Malloc'd (about 32 kB), prepared by apair_ik_closed_init; for
+                              * GENERAL_6R only its family, dh and scale are set */
+    const apair_lapack *lapack; /* GENERAL_6R: SciPy's */
     double reach; /* translations beyond it take the validating path (its reach bound answers) */
 } ClosedIKObject;
 
@@ -30,7 +34,8 @@ static void closed_dealloc(ClosedIKObject *self)
  * parallel) or 3 (axes 1, 2, 3 parallel, 5 and 6 meeting), or'ed with 4 where it sits at the base end
  * (apair_ik_closed_init); or 8 or 16, a UR-like chain with sinusoidal A-pairs of amplitudes
  * amplitude (6,) at joint 3, or at joints 1 and 5, or 32 and 64, a spherical wrist's with one at
- * joint 3, or at joint 1 (apair_ik_closed_init_apair) */
+ * joint 3, or at joint 1 (apair_ik_closed_init_apair); or 128, any six R-pairs by the 6R elimination
+ * (apair_ik6r, SciPy's LAPACK; a pose it does not certify returns None) */
 static int closed_init(ClosedIKObject *self, PyObject *args, PyObject *kwds)
 {
     PyObject *dh_obj, *amp_obj = Py_None;
@@ -72,9 +77,19 @@ static int closed_init(ClosedIKObject *self, PyObject *args, PyObject *kwds)
             return -1;
         }
         const double *d = (const double *)PyArray_DATA(dh);
-        if (apairs ? apair_ik_closed_init_apair(self->solver, d, (const double *)PyArray_DATA(amp), scale) ||
-                         self->solver->family != family
-                   : apair_ik_closed_init(self->solver, family, d, scale)) {
+        if (family == GENERAL_6R) {
+            if ((self->lapack = apair_native_lapack()) == NULL) {
+                PyMem_Free(self->solver);
+                self->solver = NULL;
+                Py_DECREF(dh);
+                return -1;
+            }
+            self->solver->family = GENERAL_6R;
+            self->solver->scale = scale;
+            memcpy(self->solver->dh, d, sizeof self->solver->dh);
+        } else if (apairs ? apair_ik_closed_init_apair(self->solver, d, (const double *)PyArray_DATA(amp), scale) ||
+                                self->solver->family != family
+                          : apair_ik_closed_init(self->solver, family, d, scale)) {
             PyMem_Free(self->solver);
             self->solver = NULL;
         }
@@ -112,7 +127,10 @@ static PyObject *closed_call(ClosedIKObject *self, PyObject *const *args, Py_ssi
         Py_RETURN_NONE;
     }
     Py_BEGIN_ALLOW_THREADS
-    rc = apair_ik_closed_solve(self->solver, 1, T, 0, tol, q, error, &found, &candidates, &flags);
+    if (self->solver->family == GENERAL_6R)
+        rc = apair_ik6r(self->lapack, self->solver->dh, self->solver->scale, T, tol, q, error, &found, &candidates);
+    else
+        rc = apair_ik_closed_solve(self->solver, 1, T, 0, tol, q, error, &found, &candidates, &flags);
     Py_END_ALLOW_THREADS
     if (rc != 0 || flags < 0) {
         Py_RETURN_NONE;
@@ -147,7 +165,7 @@ PyTypeObject apair_native_closed_ik_type = {
               "solved in closed form (1: a spherical wrist, 2: axes 2, 3, 4 parallel, 3: axes 1, 2, 3 parallel with 5, 6 "
               "meeting, | 4 at the base end; 8 and 16: a UR-like chain with sinusoidal A-pairs of amplitudes amplitude "
               "(6,) at joint 3, or at joints 1 and 5; 32 and 64: a spherical wrist's with one at joint 3, or at joint 1; "
-              "apair.ik.solver).",
+              "128: six R-pairs by the 6R elimination; apair.ik.solver).",
     .tp_methods = closed_methods,
     .tp_init = (initproc)closed_init,
     .tp_new = PyType_GenericNew,

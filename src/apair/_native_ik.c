@@ -111,6 +111,54 @@ static int run_ik6r_angles(const ik_call *c)
     return apair_ik6r_angles(c->rows, in(c, 0), in(c, 1), in(c, 2), in(c, 3), in(c, 4), in(c, 5), in(c, 6), out(c, 0));
 }
 
+/* LAPACK for apair_ik6r_solve: SciPy's scipy.linalg.cython_lapack, its function pointers read once from
+ * the module's capsules (its C-API for this use) */
+static apair_lapack ik6r_lapack;
+
+static void *lapack_pointer(PyObject *capi, const char *name)
+{
+    PyObject *capsule = PyDict_GetItemString(capi, name); /* borrowed */
+    if (capsule == NULL || !PyCapsule_CheckExact(capsule)) {
+        PyErr_Format(PyExc_ImportError, "scipy.linalg.cython_lapack has no %s", name);
+        return NULL;
+    }
+    return PyCapsule_GetPointer(capsule, PyCapsule_GetName(capsule));
+}
+
+const apair_lapack *apair_native_lapack(void)
+{
+    if (ik6r_lapack.dgeev != NULL) return &ik6r_lapack;
+    PyObject *module = PyImport_ImportModule("scipy.linalg.cython_lapack"), *capi = NULL;
+    const apair_lapack *out = NULL;
+    if (module != NULL && (capi = PyObject_GetAttrString(module, "__pyx_capi__")) != NULL && PyDict_Check(capi)) {
+        void *gesdd = lapack_pointer(capi, "dgesdd"), *gesv = gesdd ? lapack_pointer(capi, "dgesv") : NULL,
+             *geev = gesv ? lapack_pointer(capi, "dgeev") : NULL;
+        if (geev != NULL) {
+            memcpy(&ik6r_lapack.dgesdd, &gesdd, sizeof gesdd); /* (object to function pointer) */
+            memcpy(&ik6r_lapack.dgesv, &gesv, sizeof gesv);
+            memcpy(&ik6r_lapack.dgeev, &geev, sizeof geev);
+            out = &ik6r_lapack;
+        }
+    } else if (!PyErr_Occurred()) {
+        PyErr_SetString(PyExc_ImportError, "scipy.linalg.cython_lapack has no __pyx_capi__");
+    }
+    Py_XDECREF(capi);
+    Py_XDECREF(module);
+    return out;
+}
+
+static int prepare_ik6r_solve(ik_call *c)
+{
+    (void)c;
+    return apair_native_lapack() ? 0 : -1;
+}
+
+static int run_ik6r_solve(const ik_call *c)
+{
+    apair_ik_problem pb = {6, in(c, 0), in(c, 1), in(c, 2)};
+    return apair_ik6r_solve(&ik6r_lapack, &pb, in(c, 3), in(c, 4), out(c, 0));
+}
+
 static int run_newton(const ik_call *c)
 {
     apair_ik_problem pb = {6, in(c, 0), in(c, 1), in(c, 2)};
@@ -215,7 +263,7 @@ static int run_left(const ik_call *c)
 
 /* ---- the table */
 
-enum { IK_TRACK, IK_TRACK_SLICE, IK6R_ANGLES, IK_NEWTON, IK_LOCAL, IK4_PENCIL, IK4_SCREEN, IK4_LEFT, IK_WRIST, IK_PARALLEL, IK_THREE_PARALLEL,
+enum { IK_TRACK, IK_TRACK_SLICE, IK6R_ANGLES, IK6R_SOLVE, IK_NEWTON, IK_LOCAL, IK4_PENCIL, IK4_SCREEN, IK4_LEFT, IK_WRIST, IK_PARALLEL, IK_THREE_PARALLEL,
        IK_PARALLEL_APAIR, IK_WRIST_APAIR };
 
 static const ik_entry ik_entries[] = {
@@ -244,6 +292,14 @@ static const ik_entry ik_entries[] = {
                    {"sigma", F64, 1, {3}}, {"dh", F64, 2, {6, 4}}, {"T", F64, 2, {4, 4}}},
         .out = {{"theta", C128, 2, {ROWS, 6}}},
         .run = run_ik6r_angles, .error = "ik6r_angles: failed",
+    },
+    [IK6R_SOLVE] = {
+        .format = "OOOOO", /* kind, pair, dh, T, sigma */
+        .arrays = {{"kind", I32, 1, {6}}, {"pair", F64, 2, {6, 2}}, {"dh", F64, 2, {6, 4}}, {"T", F64, 2, {4, 4}},
+                   {"sigma", F64, 1, {3}}},
+        .out = {{"theta", C128, 2, {16, 6}}},
+        .nogil = 1, .prepare = prepare_ik6r_solve, .run = run_ik6r_solve,
+        .error = "ik6r_solve: the problem is not six R-pairs",
     },
     [IK_NEWTON] = {
         .format = "OOOOOidddd", /* kind, pair, dh, p, theta, max_steps, tol, floor, stall, imag_max */
@@ -442,6 +498,7 @@ done:
 static PyObject *ik_track(PyObject *m, PyObject *args) { return ik_marshal(m, IK_TRACK, args); }
 static PyObject *ik_track_slice(PyObject *m, PyObject *args) { return ik_marshal(m, IK_TRACK_SLICE, args); }
 static PyObject *ik6r_angles(PyObject *m, PyObject *args) { return ik_marshal(m, IK6R_ANGLES, args); }
+static PyObject *ik6r_solve(PyObject *m, PyObject *args) { return ik_marshal(m, IK6R_SOLVE, args); }
 static PyObject *ik_newton(PyObject *m, PyObject *args) { return ik_marshal(m, IK_NEWTON, args); }
 static PyObject *ik_local(PyObject *m, PyObject *args) { return ik_marshal(m, IK_LOCAL, args); }
 static PyObject *ik4_pencil(PyObject *m, PyObject *args) { return ik_marshal(m, IK4_PENCIL, args); }
@@ -700,6 +757,8 @@ PyMethodDef apair_native_ik_methods[] = {
      "ik_track(kind, pair, dh, p0, p1, gamma, start) -> (end, status, steps, cond): apair_ik_track."},
     {"ik6r_angles", ik6r_angles, METH_VARARGS,
      "ik6r_angles(x3, vec, P, L, sigma, dh, T) -> theta: apair_ik6r_angles."},
+    {"ik6r_solve", ik6r_solve, METH_VARARGS,
+     "ik6r_solve(kind, pair, dh, T, sigma) -> theta (16, 6), or None: apair_ik6r_solve (the 6R elimination, certified)."},
     {"ik_newton", ik_newton, METH_VARARGS,
      "ik_newton(kind, pair, dh, p, theta, max_steps, tol, floor, stall, imag_max) -> (theta, size): apair_ik_newton."},
     {"ik4_pencil", ik4_pencil, METH_VARARGS,

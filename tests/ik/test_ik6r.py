@@ -66,7 +66,17 @@ def test_the_same_16_solutions_as_the_homotopy():
             assert contains(sol.q, q) and np.abs(chain.fk(sol.q) - T).max() <= 1e-9
 
 
-def test_c_steps_agree_with_numpy():
+@pytest.fixture
+def c_backend():
+    """The C steps in use whatever APAIR_BACKEND says (the tests that hold them against their twins)."""
+    if not apair.c_available():
+        pytest.skip("the compiled C kernels are not installed")
+    apair.set_backend("c")
+    yield
+    apair.set_backend(None)
+
+
+def test_c_steps_agree_with_numpy(c_backend):
     """apair_ik6r_angles and apair_ik_newton against their NumPy versions: the same angles from the
     same eigenpairs, the same roots and step sizes after Newton (also from perturbed starts, and
     a start far out that must be reported as lost)."""
@@ -198,6 +208,36 @@ def test_special_designs_stay_complete(name):
         assert certified >= 4, name
     else:
         assert certified == 0 and start.count == 8, name
+
+
+def general_arms() -> dict[str, apair.AChain]:
+    """Six R-pairs of no closed-form family, at random and as users build them (SPECIAL's designs the
+    elimination certifies): the 6R elimination's chains (tests/ik/test_ik_closed_fast.py takes them too)."""
+    rng = np.random.default_rng(30)
+    arms = {f"random 6R #{k}": random_arm(rng) for k in range(2)}
+    arms.update({name: arm(a, alpha, c) for name, (a, alpha, c, generic) in SPECIAL.items() if generic})
+    return arms
+
+
+def test_one_c_call_is_the_numpy_steps(c_backend):
+    """apair_ik6r_solve (the elimination, else the reversed chain's, Newton and the checks, with
+    SciPy's LAPACK, in one C call) against the NumPy steps: the same 16 solutions, and None at the
+    same poses (a singular one among them), on random designs and those users build (axes 1 and 2
+    parallel: from the end; right angles; no offsets; mm and km), joints at 0 and π too."""
+    for name, chain in general_arms().items():
+        problem = homotopy.Problem.of(chain)
+        rng = np.random.default_rng(len(name))
+        qs = list(rng.uniform(-PI, PI, (5, 6))) + [np.array([0.0, PI, 0.3, PI, 0.5, -0.7]), np.zeros(6)]
+        for q in qs:
+            T = chain.fk(q)
+            c, py = ik6r.solve(problem, T, engine="c"), ik6r.solve(problem, T, engine="numpy")
+            assert (c is None) == (py is None), (name, q)
+            if c is not None:
+                assert same_sets(homotopy.canonical(problem, c), homotopy.canonical(problem, py)), (name, q)
+    singular = arm([0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4], [0.0] * 6)
+    T = singular.fk(np.zeros(6))
+    problem = homotopy.Problem.of(singular)
+    assert ik6r.solve(problem, T, engine="c") is None and ik6r.solve(problem, T, engine="numpy") is None
 
 
 def test_singular_pose_falls_back_to_the_homotopy():

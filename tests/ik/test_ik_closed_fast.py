@@ -1,7 +1,8 @@
 """The single-pose fast path of `ik` for the chains solved in closed form (apair._native.ClosedIK,
 set up with the chain's solver): the same numbers as the validating path on spherical-wrist, UR
 and 1∥2∥3 arms, UR designs with A-pairs at joint 3 or at joints 1 and 5 and spherical-wrist arms
-with an A-pair at joint 3 or 1, reachable and unreachable poses; whatever
+with an A-pair at joint 3 or 1, and six R-pairs of no such family (the 6R elimination in one C
+call, apair_ik6r; None where it does not certify), reachable and unreachable poses; whatever
 it declines (other dtypes, NaN, a pose that is not rigid, a bad tol, full=True, frames) goes to the
 validating path, which answers or raises as before; the NumPy backend keeps its twin; a chain
 pickles after ik."""
@@ -12,6 +13,7 @@ import pickle
 
 import numpy as np
 import pytest
+import test_ik6r as general_arms
 import test_ik_parallel as parallel_arms
 import test_ik_parallel_apair as apair_arms
 import test_ik_parallel_slides as slides_arms
@@ -22,6 +24,7 @@ import test_ik_wrist_slide1 as wrist_slide1_arms
 
 import apair
 from apair.frames import frame
+from apair.ik.poses import reach_of
 
 PI = np.pi
 pytestmark = pytest.mark.skipif(not apair.c_available(), reason="the compiled C kernels are not installed")
@@ -39,6 +42,7 @@ def arms():
         yield f"{name} + A-pair at joint 3", wrist_apair_arms.chain_of(name)
     for name in wrist_slide1_arms.DESIGNS:  # or at joint 1
         yield f"{name} + A-pair at joint 1", wrist_slide1_arms.chain_of(name)
+    yield from general_arms.general_arms().items()  # the 6R elimination (ClosedIK's code 128)
 
 
 @pytest.fixture(autouse=True)
@@ -58,7 +62,7 @@ def test_same_numbers_as_the_validating_path():
             fast, full = chain.ik(T), chain._ik.solve(T)
             assert fast.shape == full.q.shape and np.array_equal(fast, full.q), name
         far = np.eye(4)
-        far[:3, 3] = [50.0, 0.0, 0.0]  # beyond the reach bound: the validating path's answer, empty
+        far[:3, 3] = [2 * reach_of(chain) + 1.0, 0.0, 0.0]  # beyond the reach bound: the validating path answers
         assert chain.ik(far).shape == (0, 6) and chain._ik_fast.call(far, 1e-9) is None
 
 

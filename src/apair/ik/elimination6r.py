@@ -18,6 +18,9 @@ P(ψ3) X45 = Q X12 at the pose. Here, per pose:
 5. Every solution takes Newton steps on the homotopy system (ik_system6, complex; in C,
    apair_ik_newton, where the kernels are installed).
 
+Where the compiled kernels are installed, `solve` runs all of it in one C call (apair_ik6r_solve,
+with SciPy's LAPACK passed in); the NumPy steps here are its twin and the fallback.
+
 The answer is certified complete when 16 distinct solutions come out regular with Newton
 converged: no design has more than 16 isolated solutions at a pose (the generic count bounds the
 isolated solutions of every member of a parameterised family, and 16 is the generic 6R count).
@@ -98,9 +101,10 @@ def _complex_vectors(wi: np.ndarray, vr: np.ndarray) -> np.ndarray:
     return v
 
 
-def eliminate(dh: np.ndarray, T: np.ndarray) -> np.ndarray | None:
+def eliminate(dh: np.ndarray, T: np.ndarray, engine: str | None = None) -> np.ndarray | None:
     """The 16 candidate angle vectors θ (16, 6) complex of a 6R chain (dh (6, 4), T (4, 4), both in
-    one length unit), before Newton; None where the elimination does not apply (see the module)."""
+    one length unit), before Newton; None where the elimination does not apply (see the module).
+    engine: of the back-substitution (`angles`)."""
     P, Q = kernels.call("ik6r_equations", dh, T)
     P = P.reshape(ROWS, 27)
     P[:, 0] -= Q[:, 0]  # the constant monomial goes to the left side
@@ -126,7 +130,7 @@ def eliminate(dh: np.ndarray, T: np.ndarray) -> np.ndarray | None:
     if np.any(near[spurious] > SPURIOUS_TOL) or np.count_nonzero(x3[spurious].imag > 0) != 4:
         return None
     L = (U[:, :8] / sv) @ Vt  # (14, 8): X12 (without its constant) from the 14 equations by least squares
-    return angles(x3[keep], vecs[:, keep].T, P, L, dh, T)
+    return angles(x3[keep], vecs[:, keep].T, P, L, dh, T, engine=engine)
 
 
 def angles(
@@ -194,20 +198,26 @@ def applies(problem) -> bool:
     return problem.n == 6 and not np.any(problem.kind)
 
 
-def solve(problem, T: np.ndarray) -> np.ndarray | None:
+def solve(problem, T: np.ndarray, engine: str | None = None) -> np.ndarray | None:
     """Every complex solution θ (16, 6) of the 6R problem (apair.ik.homotopy.Problem, virtual joints
     included) at the pose T (4 × 4, the chain's units): distinct, each Newton-converged on the
-    homotopy system; None where the elimination does not certify them (see the module)."""
+    homotopy system; None where the elimination does not certify them (see the module). In one C
+    call (apair_ik6r_solve) where installed, else (engine "numpy") the NumPy steps."""
     pose = problem.pose(T)
-    theta = eliminate(problem.dh, pose)
+    native = native_in_use() if engine in (None, "c") else None
+    if native is not None:
+        return native.ik6r_solve(problem.kind, problem.pair, problem.dh, pose, _SIGMA)
+    if engine == "c":
+        raise RuntimeError("engine: the compiled C kernels are not installed")
+    theta = eliminate(problem.dh, pose, engine)
     if theta is None:  # e.g. the first two axes parallel: read the chain from its end
-        psi = eliminate(*reversed_chain(problem.dh, pose))
+        psi = eliminate(*reversed_chain(problem.dh, pose), engine)
         theta = None if psi is None else -psi[:, ::-1] - problem.dh[:, 3]
-    return None if theta is None else verified(problem, theta, pose, COUNT)
+    return None if theta is None else verified(problem, theta, pose, COUNT, engine=engine)
 
 
 def verified(
-    problem, theta: np.ndarray, pose: np.ndarray, count: int, must: np.ndarray | None = None
+    problem, theta: np.ndarray, pose: np.ndarray, count: int, must: np.ndarray | None = None, engine: str | None = None
 ) -> np.ndarray | None:
     """The `count` candidates θ (count, 6) of an elimination after Newton on the homotopy system
     at the pose, or None unless every candidate in `must` (default: all) converged and the
@@ -216,7 +226,7 @@ def verified(
     must = np.ones(count, bool) if must is None else must
     if not np.all(np.abs(theta[must].imag) <= IMAG_MAX):  # (NaN included)
         return None
-    refined, size = newton(problem, theta, target_of(pose), NEWTON, CONVERGED, ACCURATE, STALL, IMAG_MAX)
+    refined, size = newton(problem, theta, target_of(pose), NEWTON, CONVERGED, ACCURATE, STALL, IMAG_MAX, engine)
     # large |Im θ| makes the system's entries large (e^|Im θ|) and Newton stalls at its rounding
     # level; a stalled root still counts when it is far from every other root
     ok = size <= ACCURATE

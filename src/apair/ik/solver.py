@@ -147,7 +147,7 @@ class Solver:
         self.reach = math.inf if self.slides.any() else reach_of(chain)
         # the closed form's single-pose fast path in C (apair._native.ClosedIK: call(T, tol) gives what
         # solve(T, tol) would, or None where the pose needs the validating path), or None
-        self.fast = _fast_path(self._closed, self.scale, self.reach)
+        self.fast = _fast_path(self._closed, self.scale, self.reach, chain)
         self.seed = seed
         self._eliminations: dict[bool, Elimination] = {}
         self._problem: Problem | None = None  # n = 5, 6: the homotopy.Problem
@@ -327,15 +327,27 @@ class Solver:
         return np.where(self.slides, real * self.scale, real)
 
 
-def _fast_path(closed: Form | None, scale: float, reach: float) -> Any:
-    """apair._native.ClosedIK for the closed form, where the C extension is installed, else None."""
+GENERAL_6R = 128  # apair._native.ClosedIK's code for six R-pairs by the 6R elimination (apair_ik6r)
+
+
+def _fast_path(closed: Form | None, scale: float, reach: float, chain: ChainLike) -> Any:
+    """apair._native.ClosedIK for the closed form, or for six R-pairs of no closed-form family the
+    6R elimination in one C call, where the C extension is installed; else None."""
     native, _ = native_module()
-    if closed is None or native is None:
+    if native is None:
         return None
     try:
-        return native.ClosedIK(closed.code, closed.dh, scale, reach, closed.amplitude)
-    except ValueError:  # a design its C form does not prepare: the validating path answers
+        if closed is not None:
+            return native.ClosedIK(closed.code, closed.dh, scale, reach, closed.amplitude)
+        if chain.n == 6 and all(p.kind == "revolute" for p in chain.pairs):
+            dh = np.stack([chain.a, chain.alpha, chain.offset, chain.theta_offset], 1)
+            return native.ClosedIK(GENERAL_6R, dh, scale, reach)
+    except (
+        ValueError,
+        ImportError,
+    ):  # a design its C form does not prepare, no SciPy LAPACK: the validating path answers
         return None
+    return None
 
 
 def _unaccounted(ends: Endpoints) -> str:
