@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 85f14830db18faca
+Content hash: 304d74b27e3136ee
 """

@@ -62,7 +62,8 @@ static inline double closed_magnitude(int d, const double *c, double x)
 /* The real roots of sum c_k x^k (degree d <= CLOSED_DEGREE, c[d] != 0, coefficients of size about
  * 1): a root in each interval between the real roots of the derivative where the sign changes, and
  * each critical point within CLOSED_TANGENT of zero (a double root, or two roots too close to
- * separate): candidates, some repeated, at most 3 for d = 2 and 15 for d = 4, CLOSED_ROOTS in all. */
+ * separate) unless roots were bracketed on both sides of it, each more than CLOSED_SPLIT away:
+ * candidates, some repeated, at most 3 for d = 2 and 15 for d = 4, CLOSED_ROOTS in all. */
 static inline int closed_real_roots(int d, const double *c, double *roots)
 {
     if (d <= 0) return 0;
@@ -101,10 +102,14 @@ static inline int closed_real_roots(int d, const double *c, double *roots)
     for (int k = 0; k < nc; k++) ends[ne++] = fmin(fmax(crit[k], -bound), bound);
     ends[ne++] = bound;
     int n = 0;
+    double before = NAN; /* the root bracketed in the interval before this one, if any */
     for (int k = 0; k + 1 < ne; k++) {
         double lo = ends[k], hi = ends[k + 1], flo = closed_horner(d, c, lo), fhi = closed_horner(d, c, hi);
         if (n >= CLOSED_ROOTS - 1) break;
-        if (k > 0 && fabs(flo) <= CLOSED_TANGENT * fmax(1.0, closed_magnitude(d, c, lo))) roots[n++] = lo; /* at a critical point */
+        int at_crit = -1;
+        if (k > 0 && fabs(flo) <= CLOSED_TANGENT * fmax(1.0, closed_magnitude(d, c, lo))) { at_crit = n; roots[n++] = lo; } /* at a critical point */
+        double prev = before;
+        before = NAN;
         if (flo == 0.0) continue;
         if ((flo < 0) == (fhi < 0)) continue;
         /* Laguerre's method from the secant point (one step lands near a root from afar, where Newton's
@@ -133,6 +138,12 @@ static inline int closed_real_roots(int d, const double *c, double *roots)
             x = next;
         }
         roots[n++] = x;
+        before = x;
+        /* a critical point between two real roots, each more than CLOSED_SPLIT from it, is not a root
+         * (p changes sign on both sides and p(lo) != 0): two solutions, and the point between them nearly
+         * verifies, as the quadratic's above; within CLOSED_SPLIT the two are a split double root */
+        double at = ends[k], split = CLOSED_SPLIT * (1.0 + fabs(at)); /* (lo moved with the bracket) */
+        if (at_crit >= 0 && at - prev > split && x - at > split) { roots[at_crit] = x; n = at_crit + 1; }
     }
     return n;
 }

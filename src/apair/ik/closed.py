@@ -43,11 +43,17 @@ def real_roots(coeffs: NDArray[np.float64], ref: float) -> tuple[list[float], bo
         split = disc >= 0 and len(real) == 2 and abs(real[1] - real[0]) > SPLIT * (1 + abs(mid))
         if abs(disc) <= TANGENT * (c1 * c1 + abs(4 * c2 * c0) + c2 * c2) and not split:
             roots.append(float(mid))
-    elif top > 2:
+    elif top > 2:  # ... and not between two real roots each SPLIT from it, in the intervals beside it
         x = np.roots(np.polyder(poly))
-        x = x[np.abs(x.imag) <= ROOT_IMAG * (1 + np.abs(x))].real
+        x = np.sort(x[np.abs(x.imag) <= ROOT_IMAG * (1 + np.abs(x))].real)
         near = np.abs(np.polyval(poly, x)) <= TANGENT * np.maximum(1.0, np.polyval(np.abs(poly), np.abs(x)))
-        roots += x[near].tolist()
+        edges = np.concatenate([[-np.inf], x, [np.inf]])
+        for m in np.flatnonzero(near):
+            c, split = x[m], SPLIT * (1 + abs(x[m]))
+            below = [r for r in real if edges[m] < r < c]
+            above = [r for r in real if c < r < edges[m + 2]]
+            if not (below and above and c - max(below) > split and min(above) - c > split):
+                roots.append(float(c))
     return roots, at_infinity
 
 
