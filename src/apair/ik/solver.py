@@ -148,6 +148,8 @@ class Solver:
         # the closed form's single-pose fast path in C (apair._native.ClosedIK: call(T, tol) gives what
         # solve(T, tol) would, or None where the pose needs the validating path), or None
         self.fast = _fast_path(self._closed, self.scale, self.reach, chain)
+        # six R-pairs of no closed-form family: the 6R elimination's fast path, also behind full=True
+        self._fast6r = self.fast if self._closed is None else None
         self.seed = seed
         self._eliminations: dict[bool, Elimination] = {}
         self._problem: Problem | None = None  # n = 5, 6: the homotopy.Problem
@@ -261,6 +263,9 @@ class Solver:
         (apair.ik.homotopy). Real solutions verified. All three work on the design in units of its
         length scale (`_UnitDesign`) and T's translation too (a P-pair's slide is read back in m)."""
         Tm = pose.matrix
+        if self._fast6r is not None and (out := self._fast6r.call(Tm, tol)) is not None:
+            q, err, candidates, _ = out  # six R-pairs: the 6R elimination and the real solutions in C (apair_ik6r)
+            return Solution(q, err, candidates, elimination6r.COUNT, method="elimination")
         Tu = Tm.copy()
         Tu[:3, 3] /= self.scale
         if self._problem is None:
