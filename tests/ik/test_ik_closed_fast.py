@@ -66,8 +66,9 @@ def test_same_numbers_as_the_validating_path():
         assert chain.ik(far).shape == (0, 6) and chain._ik_fast.call(far, 1e-9) is None
 
 
-def test_declined_inputs_take_the_validating_path():
-    chain = parallel_arms.arm("UR5")
+@pytest.mark.parametrize("which", ["UR5", "random 6R #1"])
+def test_declined_inputs_take_the_validating_path(which):
+    chain = parallel_arms.arm("UR5") if which == "UR5" else general_arms.general_arms()[which]
     T = chain.fk(np.full(6, 0.3))
     expected = chain.ik(T)
     fast = chain._ik_fast
