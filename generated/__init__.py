@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 304d74b27e3136ee
+Content hash: 56ab015abc5774c7
 """

@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik6r.c (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik6r.c. Content hash: 4de474f1833ca366
+ * generated/c. Do not edit: edit src/csrc/apair_ik6r.c. Content hash: 79d60ff5cc9e025c
  */
 /*
  * The 6R elimination (apair.ik.elimination6r, derivations/chain_ik6r.py): its back-substitution (the
@@ -104,7 +104,7 @@ int apair_ik6r_angles(size_t count, const double *x3, const double *vec, const d
 #define IK6R_IMAG_MAX 30.0     /* IMAG_MAX */
 #define IK6R_SEPARATION 1e3    /* SEPARATION */
 #define IK6R_SAME 1e-6         /* SAME */
-#define IK6R_WORK 4096         /* doubles of LAPACK workspace (dgeev of 24 x 24 takes a few hundred) */
+#define IK6R_WORK 1024         /* doubles of LAPACK workspace: above what dgesdd (600) and dgeev (4 n = 96) need, under dgeev's blocked optimum (4283; n = 24 gains nothing from it) */
 
 /* (1, cos psi, sin psi) (1 + x^2) on (1, x, x^2), x = tan((psi - sigma)/2): elimination6r.chart */
 static void ik6r_chart(double sigma, double H[3][3])
