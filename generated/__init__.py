@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: 56ab015abc5774c7
+Content hash: f3af65019d7558fb
 """

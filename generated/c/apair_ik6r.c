@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik6r.c (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik6r.c. Content hash: 79d60ff5cc9e025c
+ * generated/c. Do not edit: edit src/csrc/apair_ik6r.c. Content hash: 488a773ed7b117de
  */
 /*
  * The 6R elimination (apair.ik.elimination6r, derivations/chain_ik6r.py): its back-substitution (the
@@ -94,7 +94,7 @@ int apair_ik6r_angles(size_t count, const double *x3, const double *vec, const d
  * caller's pointers: the library itself needs only libm), the back-substitution above, and Newton's
  * method with the checks that certify the 16 solutions. The constants are the module's. */
 
-#define IK6R_COUNT 16
+#define IK6R_COUNT 16           /* COUNT */
 #define IK6R_RANK_TOL 1e-9     /* RANK_TOL */
 #define IK6R_SPURIOUS_TOL 1e-3 /* SPURIOUS_TOL */
 #define IK6R_NEWTON 8          /* NEWTON */

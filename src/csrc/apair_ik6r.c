@@ -90,7 +90,7 @@ int apair_ik6r_angles(size_t count, const double *x3, const double *vec, const d
  * caller's pointers: the library itself needs only libm), the back-substitution above, and Newton's
  * method with the checks that certify the 16 solutions. The constants are the module's. */
 
-#define IK6R_COUNT 16
+#define IK6R_COUNT 16           /* COUNT */
 #define IK6R_RANK_TOL 1e-9     /* RANK_TOL */
 #define IK6R_SPURIOUS_TOL 1e-3 /* SPURIOUS_TOL */
 #define IK6R_NEWTON 8          /* NEWTON */

@@ -240,6 +240,24 @@ def test_one_c_call_is_the_numpy_steps(c_backend):
     assert ik6r.solve(problem, T, engine="c") is None and ik6r.solve(problem, T, engine="numpy") is None
 
 
+def test_c_constants_are_the_modules():
+    """apair_ik6r_solve's tolerances and chart turns (#define IK6R_<NAME> ... /* NAME */ and
+    ik6r_sigma in src/csrc/apair_ik6r.c) are apair.ik.elimination6r's, and apair_ik6r's real-candidate
+    tolerance is the homotopy's."""
+    import re
+    from pathlib import Path
+
+    src = (Path(__file__).resolve().parents[2] / "src" / "csrc" / "apair_ik6r.c").read_text()
+    found = re.findall(r"#define IK6R_\w+\s+([-0-9.e]+)\s+/\* ([A-Z_]+) \*/", src)
+    assert len(found) >= 10
+    for value, name in found:
+        assert float(value) == getattr(ik6r, name), name
+    real = re.search(r"#define IK6R_REAL ([-0-9.e]+)", src).group(1)
+    assert float(real) == homotopy.problem.REAL
+    sigma = re.search(r"ik6r_sigma\[3\] = \{([^}]*)\}", src).group(1)
+    assert tuple(float(x) for x in sigma.split(",")) == ik6r.SIGMA
+
+
 def test_singular_pose_falls_back_to_the_homotopy():
     """No offsets: at θ = 0 the arm is singular (a double root); the elimination declines."""
     chain = arm([0.3, 0.4, 0.2, 0.25, 0.15, 0.1], [0.7, 0.5, -1.1, 0.9, 1.3, -0.4], [0.0] * 6)

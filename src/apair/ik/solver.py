@@ -347,10 +347,8 @@ def _fast_path(closed: Form | None, scale: float, reach: float, chain: ChainLike
         if chain.n == 6 and all(p.kind == "revolute" for p in chain.pairs):
             dh = np.stack([chain.a, chain.alpha, chain.offset, chain.theta_offset], 1)
             return native.ClosedIK(GENERAL_6R, dh, scale, reach)
-    except (
-        ValueError,
-        ImportError,
-    ):  # a design its C form does not prepare, no SciPy LAPACK: the validating path answers
+    # a design its C form does not prepare, or no SciPy LAPACK: the validating path answers
+    except (ValueError, ImportError):
         return None
     return None
 
