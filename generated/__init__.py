@@ -1,4 +1,4 @@
 """Kernels and polynomials derived by derivations/, emitted by codegen/. Do not edit.
 
-Content hash: f3af65019d7558fb
+Content hash: 6ac8f192f0430abc
 """

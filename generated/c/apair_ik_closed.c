@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_closed.c (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_closed.c. Content hash: df995d107b4d6156
+ * generated/c. Do not edit: edit src/csrc/apair_ik_closed.c. Content hash: 27068a89d077e55c
  */
 /*
  * The closed-form solvers of six-joint chains behind one prepared solver (apair.h: apair_ik_closed,
@@ -121,10 +121,7 @@ static void solve_reversed(const apair_ik_closed *solver, const double *T, doubl
                            int *found, int *candidates, int *flags)
 {
     double inv[12], Tr[16], qr[6 * CLOSED_MAX], er[CLOSED_MAX];
-    for (int r = 0; r < 3; r++) {
-        for (int k = 0; k < 3; k++) inv[4 * r + k] = T[4 * k + r];
-        inv[4 * r + 3] = -(T[r] * T[3] + T[4 + r] * T[7] + T[8 + r] * T[11]);
-    }
+    closed_inv34(T, inv);
     closed_mul34(solver->front, inv, Tr);
     Tr[12] = Tr[13] = Tr[14] = 0.0;
     Tr[15] = 1.0;

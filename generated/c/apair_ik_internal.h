@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_internal.h (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_internal.h. Content hash: 4dad18ebf79d409b
+ * generated/c. Do not edit: edit src/csrc/apair_ik_internal.h. Content hash: 04e9daf703843a3d
  */
 /*
  * Private to the hand-written solvers of src/csrc (apair_ik_*.c, apair_ik4.c, apair_ik6r.c): the
@@ -55,6 +55,14 @@ static inline void closed_mul34(const double *A, const double *B, double *C) /* 
         for (int k = 0; k < 4; k++)
             t[4 * r + k] = A[4 * r] * B[k] + A[4 * r + 1] * B[4 + k] + A[4 * r + 2] * B[8 + k] + (k == 3 ? A[4 * r + 3] : 0.0);
     memcpy(C, t, sizeof t);
+}
+
+static inline void closed_inv34(const double *A, double *B) /* the inverse of a rigid 3 x 4 transform (B != A) */
+{
+    for (int r = 0; r < 3; r++) {
+        for (int k = 0; k < 3; k++) B[4 * r + k] = A[4 * k + r];
+        B[4 * r + 3] = -(A[r] * A[3] + A[4 + r] * A[7] + A[8 + r] * A[11]);
+    }
 }
 
 static inline double closed_wrap(double x) /* into (-pi, pi], as apair.ik.poses.wrap */

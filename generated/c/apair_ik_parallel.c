@@ -1,6 +1,6 @@
 /*
  * A copy of src/csrc/apair_ik_parallel.c (hand-written), made by codegen/backends/c for the library in
- * generated/c. Do not edit: edit src/csrc/apair_ik_parallel.c. Content hash: 0be31a9e224d195b
+ * generated/c. Do not edit: edit src/csrc/apair_ik_parallel.c. Content hash: f6e580d1d619e519
  */
 /*
  * The closed-form inverse kinematics of six-joint R-chains with axes 2, 3 and 4 parallel (UR arms;
@@ -21,14 +21,6 @@ typedef struct {
     double dh[24], scale, eps, P, Q, ca[6], sa[6], phi[6], o3[3];
     double inv_pos[CLOSED_INV_MAX];
 } parallel_design;
-
-static void inv34(const double *A, double *B) /* the inverse of a rigid 3 x 4 transform */
-{
-    for (int r = 0; r < 3; r++) {
-        for (int k = 0; k < 3; k++) B[4 * r + k] = A[4 * k + r];
-        B[4 * r + 3] = -(A[r] * A[3] + A[4 + r] * A[7] + A[8 + r] * A[11]);
-    }
-}
 
 /* psi_5 for (psi_1's) l1 = L_1, l2 = L_2; z1, z5: axes 2 and 6 in the base frame */
 static int psi5_of(const parallel_design *p, double l1, double l2, const double *z1, const double *z5, double *out)
@@ -70,9 +62,9 @@ static void frame3(const parallel_design *p, const double *dh, const double *Tt,
     closed_dh4(dh[0], p->ca[0], p->sa[0], dh[2], psi1, A1);
     closed_dh4(dh[16], p->ca[4], p->sa[4], dh[18], psi5, A5);
     closed_dh4(dh[20], p->ca[5], p->sa[5], dh[22], psi6, A6);
-    inv34(A1, I1);
-    inv34(A5, I5);
-    inv34(A6, I6);
+    closed_inv34(A1, I1);
+    closed_inv34(A5, I5);
+    closed_inv34(A6, I6);
     closed_mul34(I1, T34, N);
     closed_mul34(N, I6, N);
     closed_mul34(N, I5, N);

@@ -159,6 +159,12 @@ static int run_ik6r_solve(const ik_call *c)
     return apair_ik6r_solve(&ik6r_lapack, &pb, in(c, 3), in(c, 4), out(c, 0));
 }
 
+static int run_ik6r(const ik_call *c)
+{
+    int *found = out(c, 2), *candidates = out(c, 3);
+    return apair_ik6r(&ik6r_lapack, in(c, 0), c->s[1].d, in(c, 2), c->s[3].d, out(c, 0), out(c, 1), found, candidates);
+}
+
 static int run_newton(const ik_call *c)
 {
     apair_ik_problem pb = {6, in(c, 0), in(c, 1), in(c, 2)};
@@ -263,7 +269,7 @@ static int run_left(const ik_call *c)
 
 /* ---- the table */
 
-enum { IK_TRACK, IK_TRACK_SLICE, IK6R_ANGLES, IK6R_SOLVE, IK_NEWTON, IK_LOCAL, IK4_PENCIL, IK4_SCREEN, IK4_LEFT, IK_WRIST, IK_PARALLEL, IK_THREE_PARALLEL,
+enum { IK_TRACK, IK_TRACK_SLICE, IK6R_ANGLES, IK6R_SOLVE, IK6R, IK_NEWTON, IK_LOCAL, IK4_PENCIL, IK4_SCREEN, IK4_LEFT, IK_WRIST, IK_PARALLEL, IK_THREE_PARALLEL,
        IK_PARALLEL_APAIR, IK_WRIST_APAIR };
 
 static const ik_entry ik_entries[] = {
@@ -300,6 +306,13 @@ static const ik_entry ik_entries[] = {
         .out = {{"theta", C128, 2, {16, 6}}},
         .nogil = 1, .prepare = prepare_ik6r_solve, .run = run_ik6r_solve,
         .error = "ik6r_solve: the problem is not six R-pairs",
+    },
+    [IK6R] = {
+        .format = "OdOd", /* dh, scale, T, tol */
+        .arrays = {{"dh", F64, 2, {6, 4}}, {"T", F64, 2, {4, 4}}},
+        .out = {{"q", F64, 2, {16, 6}}, {"error", F64, 1, {16}}, {"found", I32, 1, {1}}, {"candidates", I32, 1, {1}}},
+        .nogil = 1, .prepare = prepare_ik6r_solve, .run = run_ik6r,
+        .error = "ik6r: a scale or tol not > 0",
     },
     [IK_NEWTON] = {
         .format = "OOOOOidddd", /* kind, pair, dh, p, theta, max_steps, tol, floor, stall, imag_max */
@@ -499,6 +512,7 @@ static PyObject *ik_track(PyObject *m, PyObject *args) { return ik_marshal(m, IK
 static PyObject *ik_track_slice(PyObject *m, PyObject *args) { return ik_marshal(m, IK_TRACK_SLICE, args); }
 static PyObject *ik6r_angles(PyObject *m, PyObject *args) { return ik_marshal(m, IK6R_ANGLES, args); }
 static PyObject *ik6r_solve(PyObject *m, PyObject *args) { return ik_marshal(m, IK6R_SOLVE, args); }
+static PyObject *ik6r(PyObject *m, PyObject *args) { return ik_marshal(m, IK6R, args); }
 static PyObject *ik_newton(PyObject *m, PyObject *args) { return ik_marshal(m, IK_NEWTON, args); }
 static PyObject *ik_local(PyObject *m, PyObject *args) { return ik_marshal(m, IK_LOCAL, args); }
 static PyObject *ik4_pencil(PyObject *m, PyObject *args) { return ik_marshal(m, IK4_PENCIL, args); }
@@ -759,6 +773,9 @@ PyMethodDef apair_native_ik_methods[] = {
      "ik6r_angles(x3, vec, P, L, sigma, dh, T) -> theta: apair_ik6r_angles."},
     {"ik6r_solve", ik6r_solve, METH_VARARGS,
      "ik6r_solve(kind, pair, dh, T, sigma) -> theta (16, 6), or None: apair_ik6r_solve (the 6R elimination, certified)."},
+    {"ik6r", ik6r, METH_VARARGS,
+     "ik6r(dh, scale, T, tol) -> (q (16, 6), error (16,), found (1,), candidates (1,)), or None where it does not "
+     "certify: apair_ik6r."},
     {"ik_newton", ik_newton, METH_VARARGS,
      "ik_newton(kind, pair, dh, p, theta, max_steps, tol, floor, stall, imag_max) -> (theta, size): apair_ik_newton."},
     {"ik4_pencil", ik4_pencil, METH_VARARGS,

@@ -233,12 +233,9 @@ static void ik6r_reversed(const double *dh, const double *T, double *rdh, double
         rdh[4 * k + 2] = -dh[4 * (5 - k) + 2];
         rdh[4 * k + 3] = 0.0;
     }
-    double ca = cos(dh[21]), sa = sin(dh[21]);
-    double base[12] = {1, 0, 0, dh[20], 0, ca, -sa, 0, 0, sa, ca, 0}, inv[12];
-    for (int r = 0; r < 3; r++) {
-        for (int k = 0; k < 3; k++) inv[4 * r + k] = T[4 * k + r];
-        inv[4 * r + 3] = -(T[r] * T[3] + T[4 + r] * T[7] + T[8 + r] * T[11]);
-    }
+    double base[12], inv[12];
+    closed_dh4(dh[20], cos(dh[21]), sin(dh[21]), 0.0, 0.0, base);
+    closed_inv34(T, inv);
     closed_mul34(base, inv, rT);
     rT[12] = rT[13] = rT[14] = 0.0;
     rT[15] = 1.0;

@@ -53,6 +53,14 @@ static inline void closed_mul34(const double *A, const double *B, double *C) /* 
     memcpy(C, t, sizeof t);
 }
 
+static inline void closed_inv34(const double *A, double *B) /* the inverse of a rigid 3 x 4 transform (B != A) */
+{
+    for (int r = 0; r < 3; r++) {
+        for (int k = 0; k < 3; k++) B[4 * r + k] = A[4 * k + r];
+        B[4 * r + 3] = -(A[r] * A[3] + A[4 + r] * A[7] + A[8 + r] * A[11]);
+    }
+}
+
 static inline double closed_wrap(double x) /* into (-pi, pi], as apair.ik.poses.wrap */
 {
     return x - 2 * CLOSED_PI * ceil((x - CLOSED_PI) / (2 * CLOSED_PI));

@@ -18,14 +18,6 @@ typedef struct {
     double inv_pos[CLOSED_INV_MAX];
 } parallel_design;
 
-static void inv34(const double *A, double *B) /* the inverse of a rigid 3 x 4 transform */
-{
-    for (int r = 0; r < 3; r++) {
-        for (int k = 0; k < 3; k++) B[4 * r + k] = A[4 * k + r];
-        B[4 * r + 3] = -(A[r] * A[3] + A[4 + r] * A[7] + A[8 + r] * A[11]);
-    }
-}
-
 /* psi_5 for (psi_1's) l1 = L_1, l2 = L_2; z1, z5: axes 2 and 6 in the base frame */
 static int psi5_of(const parallel_design *p, double l1, double l2, const double *z1, const double *z5, double *out)
 {
@@ -66,9 +58,9 @@ static void frame3(const parallel_design *p, const double *dh, const double *Tt,
     closed_dh4(dh[0], p->ca[0], p->sa[0], dh[2], psi1, A1);
     closed_dh4(dh[16], p->ca[4], p->sa[4], dh[18], psi5, A5);
     closed_dh4(dh[20], p->ca[5], p->sa[5], dh[22], psi6, A6);
-    inv34(A1, I1);
-    inv34(A5, I5);
-    inv34(A6, I6);
+    closed_inv34(A1, I1);
+    closed_inv34(A5, I5);
+    closed_inv34(A6, I6);
     closed_mul34(I1, T34, N);
     closed_mul34(N, I6, N);
     closed_mul34(N, I5, N);

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..kernels import native_module
+from ..kernels import native_in_use, native_module
 from . import elimination1a5r, elimination6r, homotopy
 from .elimination4 import CAND_TOL, Elimination
 from .families import classify
@@ -147,9 +147,10 @@ class Solver:
         self.reach = math.inf if self.slides.any() else reach_of(chain)
         # the closed form's single-pose fast path in C (apair._native.ClosedIK: call(T, tol) gives what
         # solve(T, tol) would, or None where the pose needs the validating path), or None
-        self.fast = _fast_path(self._closed, self.scale, self.reach, chain)
-        # six R-pairs of no closed-form family: the 6R elimination's fast path, also behind full=True
-        self._fast6r = self.fast if self._closed is None else None
+        # six R-pairs of no closed-form family: their DH constants (6, 4) for the 6R elimination in C
+        six_r = self._closed is None and n == 6 and all(p.kind == "revolute" for p in chain.pairs)
+        self._dh6r = np.stack([chain.a, chain.alpha, chain.offset, chain.theta_offset], 1) if six_r else None
+        self.fast = _fast_path(self._closed, self.scale, self.reach, self._dh6r)
         self.seed = seed
         self._eliminations: dict[bool, Elimination] = {}
         self._problem: Problem | None = None  # n = 5, 6: the homotopy.Problem
@@ -263,9 +264,14 @@ class Solver:
         (apair.ik.homotopy). Real solutions verified. All three work on the design in units of its
         length scale (`_UnitDesign`) and T's translation too (a P-pair's slide is read back in m)."""
         Tm = pose.matrix
-        if self._fast6r is not None and (out := self._fast6r.call(Tm, tol)) is not None:
-            q, err, candidates, _ = out  # six R-pairs: the 6R elimination and the real solutions in C (apair_ik6r)
-            return Solution(q, err, candidates, elimination6r.COUNT, method="elimination")
+        declined = False  # six R-pairs: the 6R elimination and the real solutions in one C call (apair_ik6r)
+        if self._dh6r is not None and (native := native_in_use()) is not None:
+            out = native.ik6r(self._dh6r, self.scale, Tm, tol)
+            if out is not None:
+                q, err, found, candidates = out
+                k = int(found[0])
+                return Solution(q[:k], err[:k], int(candidates[0]), elimination6r.COUNT, method="elimination")
+            declined = True  # not certified: the same elimination in elimination6r.solve would decline again
         Tu = Tm.copy()
         Tu[:3, 3] /= self.scale
         if self._problem is None:
@@ -273,7 +279,7 @@ class Solver:
         problem = self._problem
         theta = None
         for route in (elimination6r, elimination1a5r):
-            if route.applies(problem):
+            if route.applies(problem) and not (declined and route is elimination6r):
                 theta = route.solve(problem, Tu)
         note = ""
         if theta is not None:
@@ -335,18 +341,17 @@ class Solver:
 GENERAL_6R = 128  # apair._native.ClosedIK's code for six R-pairs by the 6R elimination (apair_ik6r)
 
 
-def _fast_path(closed: Form | None, scale: float, reach: float, chain: ChainLike) -> Any:
-    """apair._native.ClosedIK for the closed form, or for six R-pairs of no closed-form family the
-    6R elimination in one C call, where the C extension is installed; else None."""
+def _fast_path(closed: Form | None, scale: float, reach: float, dh6r: NDArray[np.float64] | None) -> Any:
+    """apair._native.ClosedIK for the closed form, or for six R-pairs of no closed-form family (their
+    DH constants dh6r) the 6R elimination in one C call, where the C extension is installed; else None."""
     native, _ = native_module()
     if native is None:
         return None
     try:
         if closed is not None:
             return native.ClosedIK(closed.code, closed.dh, scale, reach, closed.amplitude)
-        if chain.n == 6 and all(p.kind == "revolute" for p in chain.pairs):
-            dh = np.stack([chain.a, chain.alpha, chain.offset, chain.theta_offset], 1)
-            return native.ClosedIK(GENERAL_6R, dh, scale, reach)
+        if dh6r is not None:
+            return native.ClosedIK(GENERAL_6R, dh6r, scale, reach)
     # a design its C form does not prepare, or no SciPy LAPACK: the validating path answers
     except (ValueError, ImportError):
         return None
