@@ -90,16 +90,16 @@ def _among(q, sols, period: float = 2 * PI) -> bool:
     return bool(np.any(np.all(d < SAME, axis=1)))
 
 
-def _ikgeo(eaik_robot, chain):
-    """IK-Geo's solver of the arm's family (spherical wrist with 2∥3, or UR's), with its frame conventions
-    read off fk at q = 0 (its rotations come transposed; its end frame differs from DH's by a
-    rotation), or None where IK-Geo is missing."""
+def _ikgeo(eaik_robot, chain, make: str | None = None):
+    """IK-Geo's solver `make` (default: the arm's family's, spherical wrist with 2∥3 or UR's), with its
+    frame conventions read off fk at q = 0 (its rotations come transposed; its end frame differs from
+    DH's by a rotation), or None where IK-Geo is missing."""
     try:
         import ik_geo
     except ImportError:
         return None
     H, P = np.asarray(eaik_robot.getOriginal_H()).T, np.asarray(eaik_robot.getOriginal_P()).T
-    make = IKGEO.get(chain.kinematic_family().key, "spherical_two_parallel")
+    make = make or IKGEO.get(chain.kinematic_family().key, "spherical_two_parallel")
     geo = getattr(ik_geo.Robot, make)(H.tolist(), P.tolist())
     R0, _ = geo.forward_kinematics([0.0] * 6)
     tool = np.asarray(R0) @ chain.fk(np.zeros(6))[:3, :3]
@@ -270,24 +270,15 @@ def general_section(quick: bool) -> dict:
 
 
 def _ikgeo_general(chain):
-    """IK-Geo's general 6R solver (`gen_six_dof`) on the chain's axes, T -> its answer, or None where
-    IK-Geo or EAIK (whose DH reading gives the axes) is missing."""
+    """IK-Geo's general 6R solver (`gen_six_dof`) on the chain's axes (EAIK's reading of its DH
+    constants), T -> its answer, or None where IK-Geo or EAIK is missing."""
     try:
-        import ik_geo
         from eaik.IK_DH import DhRobot
     except ImportError:
         return None
     robot = DhRobot(np.asarray(chain.alpha, float), np.asarray(chain.a, float), np.asarray(chain.offset, float))
-    H, P = np.asarray(robot.getOriginal_H()).T, np.asarray(robot.getOriginal_P()).T
-    geo = ik_geo.Robot.gen_six_dof(H.tolist(), P.tolist())
-    R0, _ = geo.forward_kinematics([0.0] * 6)
-    tool = np.asarray(R0) @ chain.fk(np.zeros(6))[:3, :3]
-
-    def solve(T):
-        R = (T[:3, :3] @ tool.T).T
-        return geo.get_ik(R.tolist(), T[:3, 3].tolist())
-
-    return solve
+    found = _ikgeo(robot, chain, "gen_six_dof")
+    return None if found is None else found[0]
 
 
 A_ARMS = {  # UR arms with sinusoidal A-pairs (r_b = 0.06, r_p = 0.05: h = 0.0775 m) at these joints (from 1)
