@@ -161,8 +161,7 @@ static int run_ik6r_solve(const ik_call *c)
 
 static int run_ik6r(const ik_call *c)
 {
-    int *found = out(c, 2), *candidates = out(c, 3);
-    return apair_ik6r(&ik6r_lapack, in(c, 0), c->s[1].d, in(c, 2), c->s[3].d, out(c, 0), out(c, 1), found, candidates);
+    return apair_ik6r(&ik6r_lapack, in(c, 0), c->s[1].d, in(c, 2), c->s[3].d, out(c, 0), out(c, 1), out(c, 2), out(c, 3));
 }
 
 static int run_newton(const ik_call *c)
@@ -774,8 +773,7 @@ PyMethodDef apair_native_ik_methods[] = {
     {"ik6r_solve", ik6r_solve, METH_VARARGS,
      "ik6r_solve(kind, pair, dh, T, sigma) -> theta (16, 6), or None: apair_ik6r_solve (the 6R elimination, certified)."},
     {"ik6r", ik6r, METH_VARARGS,
-     "ik6r(dh, scale, T, tol) -> (q (16, 6), error (16,), found (1,), candidates (1,)), or None where it does not "
-     "certify: apair_ik6r."},
+     "ik6r(dh, scale, T, tol) -> (q (16, 6), error (16,), found (1,), candidates (1,)), or None: apair_ik6r."},
     {"ik_newton", ik_newton, METH_VARARGS,
      "ik_newton(kind, pair, dh, p, theta, max_steps, tol, floor, stall, imag_max) -> (theta, size): apair_ik_newton."},
     {"ik4_pencil", ik4_pencil, METH_VARARGS,
